@@ -1,0 +1,5 @@
+import sys
+
+from tailbeam.cli import main
+
+sys.exit(main())

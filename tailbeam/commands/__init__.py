@@ -1,0 +1,1 @@
+"""Sub-commands of the ``tailbeam`` CLI, one module each."""
