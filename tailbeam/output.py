@@ -15,6 +15,8 @@ def atomic_output_dir(out_dir):
     On any exception the temporary directory is removed and ``out_dir`` is left as it was.
     """
     out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise FileExistsError(17, "the output path exists and is not a folder", str(out_dir))
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
     try:

@@ -1,0 +1,179 @@
+"""Writing simulation results: impacts.csv/json, timeseries.csv, sensors.csv, claims tables.
+
+Plain CSV (comma separated, one header line, SI units, floats written with ``repr`` so they
+read back bit for bit) and JSON (NaN written as null). No physics here.
+"""
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+# Column order of impacts.csv: the contract's first ten columns, then the rest.
+IMPACT_COLUMNS = (
+    "ball",
+    "index",
+    "t_start",
+    "t_end",
+    "v_in",
+    "v_out",
+    "restitution",
+    "peak_force",
+    "t_peak",
+    "max_penetration",
+    "next_apex_height",
+    "ends_at_rest",
+)
+IMPACT_UNITS = {
+    "t_start": "s",
+    "t_end": "s",
+    "v_in": "m/s",
+    "v_out": "m/s",
+    "restitution": "1",
+    "peak_force": "N",
+    "t_peak": "s",
+    "max_penetration": "m",
+    "next_apex_height": "m",
+}
+
+
+def _cell(value) -> str:
+    if isinstance(value, bool | np.bool_):
+        return "true" if value else "false"
+    if isinstance(value, float | np.floating):
+        return repr(float(value))
+    return str(value)
+
+
+def write_csv(path, header, rows) -> Path:
+    """Write ``rows`` (iterables of cells) under ``header`` to ``path``."""
+    path = Path(path)
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow(header)
+        for row in rows:
+            w.writerow([_cell(v) for v in row])
+    return path
+
+
+def write_impacts_csv(path, impacts) -> Path:
+    """One row per contact, columns IMPACT_COLUMNS."""
+    return write_csv(
+        path, IMPACT_COLUMNS, ([getattr(i, c) for c in IMPACT_COLUMNS] for i in impacts)
+    )
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    if isinstance(value, int | np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        value = float(value)
+        return value if math.isfinite(value) else None
+    return value
+
+
+def write_json(path, data) -> Path:
+    """JSON with NaN/inf as null (strict JSON)."""
+    path = Path(path)
+    path.write_text(json.dumps(_jsonable(data), indent=2, allow_nan=False) + "\n")
+    return path
+
+
+def result_summary(result, scene_echo: dict | None = None) -> dict:
+    """The content of impacts.json: scene echo, impacts, rest times, solver statistics."""
+    out = {}
+    if scene_echo is not None:
+        out["scene"] = scene_echo
+    out["units"] = IMPACT_UNITS
+    out["impacts"] = [{c: getattr(i, c) for c in IMPACT_COLUMNS} for i in result.impacts]
+    out["rest_time"] = dict(result.rest_time)
+    out["solver"] = {
+        "nfev": getattr(result, "nfev", None),
+        "n_steps": getattr(result, "n_steps", None),
+        "status": getattr(result, "status", None),
+        "message": getattr(result, "message", ""),
+    }
+    return out
+
+
+def timeseries(result, sample_rate: float):
+    """(header, columns) of the time series: t, then z_, vz_, force_ per ball.
+
+    Sampled on ``result.time_grid(sample_rate)``: the uniform grid plus every impact's peak
+    time, so each force peak is in the file.
+    """
+    t = result.time_grid(sample_rate)
+    states = result.sample(t)
+    header, cols = ["t"], [t]
+    for name, s in states.items():
+        header += [f"z_{name}", f"vz_{name}", f"force_{name}"]
+        cols += [s["z"], s["vz"], s["force"]]
+    return header, cols
+
+
+def write_timeseries_csv(path, result, sample_rate: float) -> Path:
+    header, cols = timeseries(result, sample_rate)
+    return write_csv(path, header, zip(*(np.asarray(c, dtype=float) for c in cols), strict=True))
+
+
+def write_sensors_csv(path, sensor_signals: dict) -> Path:
+    """t, then one column per sensor (m/s^2). Sensors sharing a sample rate share the t column;
+    if their time bases differ each sensor gets its own t_<name> column."""
+    names = list(sensor_signals)
+    times = [np.asarray(sensor_signals[n][0], dtype=float) for n in names]
+    accs = [np.asarray(sensor_signals[n][1], dtype=float) for n in names]
+    if all(t.shape == times[0].shape and np.array_equal(t, times[0]) for t in times):
+        header = ["t"] + names
+        cols = [times[0]] + accs
+        return write_csv(path, header, zip(*cols, strict=True))
+    n = max(len(t) for t in times)
+    header, cols = [], []
+    for name, t, a in zip(names, times, accs, strict=True):
+        header += [f"t_{name}", name]
+        pad = np.full(n - len(t), np.nan)
+        cols += [np.concatenate([t, pad]), np.concatenate([a, pad])]
+    return write_csv(path, header, zip(*cols, strict=True))
+
+
+def write_claims(out_dir, claims, *, stem: str = "claims") -> tuple[Path, Path]:
+    """<stem>.csv and <stem>.md: one row per claim with PASS/FAIL and the numbers behind it."""
+    out_dir = Path(out_dir)
+    header = ("id", "section", "verdict", "statement", "quantity", "threshold", "numbers")
+    rows = [
+        (
+            c.id,
+            c.section,
+            "PASS" if c.passed else "FAIL",
+            c.statement,
+            c.quantity,
+            c.threshold,
+            c.numbers(),
+        )
+        for c in claims
+    ]
+    csv_path = write_csv(out_dir / f"{stem}.csv", header, rows)
+    md = [
+        "| claim | section | verdict | paper (paraphrase) | threshold | numbers |",
+        "|---|---|---|---|---|---|",
+    ]
+    for c in claims:
+        cells = [
+            c.id,
+            c.section,
+            "PASS" if c.passed else "**FAIL**",
+            c.statement,
+            c.threshold,
+            c.numbers(3),
+        ]
+        md.append("| " + " | ".join(s.replace("|", "\\|") for s in cells) + " |")
+    md_path = out_dir / f"{stem}.md"
+    md_path.write_text("\n".join(md) + "\n")
+    return csv_path, md_path

@@ -1,0 +1,371 @@
+"""Scene files (TOML): read, validate and write back.
+
+The keys are a contract with users (README, "Scene files"): they may be extended, never renamed.
+Every problem becomes ``InputError(field, rule)`` naming the offending key (``balls[2].radius``,
+balls counted from 1) and the rule; misspelled keys get the closest valid key as a suggestion.
+Omitted optional keys take the defaults of ``tailbeam.scene``.
+"""
+
+import difflib
+import math
+import sys
+from pathlib import Path
+
+from tailbeam.bodies import Ball, Plate, check_ball_above_plate
+from tailbeam.errors import InputError, require_positive, require_real, require_vector
+from tailbeam.materials import BUILTIN_MATERIALS, Material, get_material
+from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene, SensorSpec
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+TOP_KEYS = ("duration", "sample_rate", "contact", "plate", "materials", "balls", "sensors")
+CONTACT_KEYS = ("exponent", "damping", "penetration", "clamp")
+PLATE_KEYS = ("model", "material", "size")
+MODAL_KEYS = (
+    "boundary",
+    "theory",
+    "damping_ratio",
+    "rayleigh",
+    "fmax",
+    "mesh_divisions",
+    "residual_flexibility",
+    "coupling",
+)
+MATERIAL_KEYS = ("density", "youngs_modulus", "poisson_ratio")
+BALL_KEYS = ("name", "material", "radius", "position", "velocity")
+SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance")
+
+
+def load_scene(path) -> Scene:
+    """Read and validate the scene file at ``path``. OSError if it cannot be read."""
+    path = Path(path)
+    text = path.read_bytes().decode("utf-8", errors="replace")
+    return loads_scene(text, source=path.name)
+
+
+def loads_scene(text: str, *, source: str = "scene") -> Scene:
+    """Parse TOML ``text``; ``source`` names it in the error of unparseable TOML."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        # The message carries "(at line L, column C)".
+        raise InputError(source, f"is not valid TOML: {err}") from None
+    return parse_scene(data)
+
+
+def parse_scene(data: dict) -> Scene:
+    """Build a Scene from the parsed TOML table ``data``."""
+    _check_keys("", data, TOP_KEYS, required=("duration", "balls"))
+    materials = _parse_materials(data.get("materials", {}))
+    contact = _parse_contact(_table("contact", data.get("contact", {})))
+    plate, model, modal = _parse_plate(_table("plate", data.get("plate", {})), materials)
+    balls = _parse_balls(data["balls"], materials, plate)
+    _check_ball_paths(balls, require_positive("duration", data["duration"]))
+    sensors = _parse_sensors(data.get("sensors", []), plate)
+    if sensors and model != "modal":
+        raise InputError("sensors", "need plate.model = 'modal' (a rigid plate does not vibrate)")
+    kwargs = {}
+    if "sample_rate" in data:
+        kwargs["sample_rate"] = require_positive("sample_rate", data["sample_rate"])
+    return Scene(
+        balls,
+        plate,
+        contact,
+        require_positive("duration", data["duration"]),
+        plate_model=model,
+        modal=modal,
+        sensors=sensors,
+        **kwargs,
+    )
+
+
+# -- helpers --------------------------------------------------------------------------------------
+
+
+def _join(prefix: str, key: str) -> str:
+    return f"{prefix}.{key}" if prefix else key
+
+
+def _check_keys(prefix: str, table: dict, allowed, *, required=()) -> None:
+    for key in table:
+        if key not in allowed:
+            close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)
+            hint = (
+                f"; did you mean {close[0]!r}?" if close else f"; valid keys: {', '.join(allowed)}"
+            )
+            raise InputError(_join(prefix, key), f"unknown key{hint}")
+    for key in required:
+        if key not in table:
+            raise InputError(_join(prefix, key), "is required but missing")
+
+
+def _table(field: str, value) -> dict:
+    if not isinstance(value, dict):
+        raise InputError(field, f"must be a table ([{field}]), got {type(value).__name__}")
+    return value
+
+
+def _string(field: str, value) -> str:
+    if not isinstance(value, str) or not value:
+        raise InputError(field, f"must be a non-empty string, got {value!r}")
+    return value
+
+
+def _bool(field: str, value) -> bool:
+    if not isinstance(value, bool):
+        raise InputError(field, f"must be true or false, got {value!r}")
+    return value
+
+
+def _whole(field: str, value) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise InputError(field, f"must be a whole number >= 1, got {value!r}")
+    return value
+
+
+def _array_of_tables(field: str, value) -> list:
+    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+        raise InputError(field, f"must be an array of tables ([[{field}]])")
+    return value
+
+
+# -- sections -------------------------------------------------------------------------------------
+
+
+def _parse_materials(value) -> dict:
+    out = {}
+    for name, props in _table("materials", value).items():
+        field = f"materials.{name}"
+        _check_keys(field, _table(field, props), MATERIAL_KEYS, required=MATERIAL_KEYS)
+        vals = {k: require_real(f"{field}.{k}", props[k]) for k in MATERIAL_KEYS}
+        out[name] = Material(name, **vals)
+    return out
+
+
+def _parse_contact(table: dict) -> ContactSettings:
+    _check_keys("contact", table, CONTACT_KEYS)
+    kwargs = {k: require_real(f"contact.{k}", table[k]) for k in CONTACT_KEYS[:3] if k in table}
+    if "clamp" in table:
+        kwargs["clamp"] = _bool("contact.clamp", table["clamp"])
+    return ContactSettings(**kwargs)
+
+
+def _parse_plate(table: dict, materials: dict):
+    model = table.get("model", "rigid")
+    allowed = PLATE_KEYS + MODAL_KEYS if model == "modal" else PLATE_KEYS
+    for key in table:
+        if key in MODAL_KEYS and model != "modal":
+            raise InputError(f"plate.{key}", "is only valid with model = 'modal'")
+    _check_keys("plate", table, allowed)
+    if model not in ("rigid", "modal"):
+        raise InputError("plate.model", f"must be 'rigid' or 'modal', got {model!r}")
+    kwargs = {}
+    if "material" in table:
+        name = _string("plate.material", table["material"])
+        kwargs["material"] = get_material(name, materials, field="plate.material")
+    if "size" in table:
+        a, b, h = require_vector("plate.size", table["size"], 3)
+        for i, v in enumerate((a, b, h)):
+            require_positive(f"plate.size[{i}]", v)
+        kwargs.update(size_x=a, size_y=b, thickness=h)
+    plate = Plate(**kwargs)
+    modal = None
+    if model == "modal":
+        m = {}
+        for key in ("boundary", "theory", "coupling"):
+            if key in table:
+                m[key] = _string(f"plate.{key}", table[key])
+        if "damping_ratio" in table:
+            m["damping_ratio"] = require_real("plate.damping_ratio", table["damping_ratio"])
+        if "rayleigh" in table:
+            m["rayleigh"] = require_vector("plate.rayleigh", table["rayleigh"], 2)
+        if "fmax" in table:
+            m["fmax_hz"] = require_real("plate.fmax", table["fmax"])
+        if "mesh_divisions" in table:
+            m["mesh_divisions"] = _whole("plate.mesh_divisions", table["mesh_divisions"])
+        if "residual_flexibility" in table:
+            m["residual_flexibility"] = _bool(
+                "plate.residual_flexibility", table["residual_flexibility"]
+            )
+        modal = ModalPlateSettings(**m)
+    return plate, model, modal
+
+
+def _parse_balls(value, materials: dict, plate: Plate) -> tuple:
+    tables = _array_of_tables("balls", value)
+    if not tables:
+        raise InputError("balls", "a scene needs at least one [[balls]] entry")
+    balls = []
+    for i, t in enumerate(tables, start=1):
+        field = f"balls[{i}]"
+        _check_keys(field, t, BALL_KEYS, required=("name", "material", "radius", "position"))
+        name = _string(f"{field}.name", t["name"])
+        material = get_material(
+            _string(f"{field}.material", t["material"]), materials, field=f"{field}.material"
+        )
+        radius = require_positive(f"{field}.radius", t["radius"])
+        position = require_vector(f"{field}.position", t["position"], 3)
+        velocity = require_vector(f"{field}.velocity", t.get("velocity", (0.0, 0.0, 0.0)), 3)
+        ball = Ball(name, material, radius, position, velocity)
+        try:
+            check_ball_above_plate(ball, plate)
+        except InputError as err:
+            raise InputError(f"{field}.position", err.rule) from None
+        if not plate.contains(position[0], position[1]):
+            raise InputError(
+                f"{field}.position",
+                f"the centre (x, y) = ({position[0]!r}, {position[1]!r}) m must lie over the "
+                f"plate, |x| <= {plate.size_x / 2!r}, |y| <= {plate.size_y / 2!r}",
+            )
+        balls.append(ball)
+    return tuple(balls)
+
+
+def _check_ball_paths(balls, duration: float) -> None:
+    """Ball-ball contact is not modelled: the horizontal paths (uniform lateral motion) of any two
+    balls must stay at least r1 + r2 apart during the simulation, else they could touch."""
+    for j, b in enumerate(balls):
+        for a in balls[:j]:
+            dx = b.position[0] - a.position[0]
+            dy = b.position[1] - a.position[1]
+            ux = b.velocity[0] - a.velocity[0]
+            uy = b.velocity[1] - a.velocity[1]
+            reach = a.radius + b.radius
+            t = _first_approach(dx, dy, ux, uy, reach, duration)
+            if t is not None:
+                raise InputError(
+                    f"balls[{j + 1}].position",
+                    f"ball {b.name!r} comes closer (horizontally) than the sum of the radii, "
+                    f"{reach:.4g} m, to ball {a.name!r} at t = {t:.4g} s, so they could touch; "
+                    "ball-ball contact is not modelled",
+                )
+
+
+def _first_approach(dx, dy, ux, uy, reach, duration):
+    """First t in [0, duration] with |(dx, dy) + (ux, uy) t| <= reach (None if never)."""
+    c = dx * dx + dy * dy - reach * reach
+    if c < 0.0:
+        return 0.0
+    a = ux * ux + uy * uy
+    b = dx * ux + dy * uy
+    disc = b * b - a * c
+    if a == 0.0 or b >= 0.0 or disc < 0.0:
+        return None  # not approaching, or passing wide
+    t = (-b - math.sqrt(disc)) / a
+    return t if t <= duration else None
+
+
+def _parse_sensors(value, plate: Plate) -> tuple:
+    sensors = []
+    for i, t in enumerate(_array_of_tables("sensors", value), start=1):
+        field = f"sensors[{i}]"
+        _check_keys(field, t, SENSOR_KEYS, required=("name", "position"))
+        name = _string(f"{field}.name", t["name"])
+        x, y = require_vector(f"{field}.position", t["position"], 2)
+        if not plate.contains(x, y):
+            raise InputError(f"{field}.position", f"({x!r}, {y!r}) m is not on the plate")
+        kwargs = {}
+        for key, arg in (
+            ("sample_rate", "sample_rate"),
+            ("bandwidth", "bandwidth_hz"),
+            ("mounted_resonance", "mounted_resonance_hz"),
+        ):
+            if key in t:
+                kwargs[arg] = require_real(f"{field}.{key}", t[key])
+        sensors.append(SensorSpec(name, (x, y), **kwargs))
+    return tuple(sensors)
+
+
+# -- writing back ---------------------------------------------------------------------------------
+
+
+def scene_to_dict(scene: Scene) -> dict:
+    """The scene as a table with the scene-file keys (for echoing into results, or dumping)."""
+    c = scene.contact
+    p = scene.plate
+    plate = {
+        "model": scene.plate_model,
+        "material": p.material.name,
+        "size": [p.size_x, p.size_y, p.thickness],
+    }
+    if scene.plate_model == "modal" and scene.modal is not None:
+        m = scene.modal
+        plate.update(
+            boundary=m.boundary,
+            theory=m.theory,
+            damping_ratio=m.damping_ratio,
+            residual_flexibility=m.residual_flexibility,
+            coupling=m.coupling,
+        )
+        if m.rayleigh is not None:
+            plate["rayleigh"] = list(m.rayleigh)
+        if m.fmax_hz is not None:
+            plate["fmax"] = m.fmax_hz
+        if m.mesh_divisions is not None:
+            plate["mesh_divisions"] = m.mesh_divisions
+    used = {b.material for b in scene.balls} | {p.material}
+    materials = {
+        m.name: {k: getattr(m, k) for k in MATERIAL_KEYS}
+        for m in sorted(used, key=lambda m: m.name)
+        if BUILTIN_MATERIALS.get(m.name) != m
+    }
+    out = {"duration": scene.duration, "sample_rate": scene.sample_rate}
+    out["contact"] = {
+        "exponent": c.exponent,
+        "damping": c.damping,
+        "penetration": c.penetration,
+        "clamp": c.clamp,
+    }
+    out["plate"] = plate
+    if materials:
+        out["materials"] = materials
+    out["balls"] = [
+        {
+            "name": b.name,
+            "material": b.material.name,
+            "radius": b.radius,
+            "position": list(b.position),
+            "velocity": list(b.velocity),
+        }
+        for b in scene.balls
+    ]
+    sensors = []
+    for s in scene.sensors:
+        d = {"name": s.name, "position": list(s.position), "sample_rate": s.sample_rate}
+        if s.bandwidth_hz is not None:
+            d["bandwidth"] = s.bandwidth_hz
+        if s.mounted_resonance_hz is not None:
+            d["mounted_resonance"] = s.mounted_resonance_hz
+        sensors.append(d)
+    if sensors:
+        out["sensors"] = sensors
+    return out
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return repr(v) if math.isfinite(v) else ("nan" if v != v else ("inf" if v > 0 else "-inf"))
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+
+
+def dumps_scene(scene: Scene) -> str:
+    """The scene as scene-file TOML text (``loads_scene(dumps_scene(s)) == s``)."""
+    d = scene_to_dict(scene)
+    lines = [f"{k} = {_toml_value(d[k])}" for k in ("duration", "sample_rate")]
+    for section in ("contact", "plate"):
+        lines += ["", f"[{section}]"] + [f"{k} = {_toml_value(v)}" for k, v in d[section].items()]
+    for name, props in d.get("materials", {}).items():
+        lines += ["", f"[materials.{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in props.items()]
+    for array in ("balls", "sensors"):
+        for entry in d.get(array, []):
+            lines += ["", f"[[{array}]]"] + [f"{k} = {_toml_value(v)}" for k, v in entry.items()]
+    return "\n".join(lines) + "\n"
