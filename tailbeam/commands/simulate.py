@@ -5,7 +5,6 @@ DIR. Bad input is reported as one line on stderr with exit code 2, and nothing i
 scene is fully validated before the solver runs, and results go through atomic_output_dir.
 """
 
-from tailbeam.errors import InputError
 from tailbeam.output import atomic_output_dir
 from tailbeam.results_io import (
     result_summary,
@@ -23,36 +22,16 @@ def add_arguments(parser):
 
 
 def solve(scene):
-    """Run the scene's solver: rigid plate -> simulate_rigid, modal plate -> simulate_coupled."""
+    """Run the scene's solver: rigid plate -> simulate_rigid, modal plate -> the coupled model."""
     if scene.plate_model == "rigid":
         from tailbeam.rigid import simulate_rigid
 
         return simulate_rigid(scene.balls, scene.plate, scene.laws(), scene.duration)
-    try:
-        from tailbeam.coupled import simulate_coupled
-        from tailbeam.plate import compute_modes
-    except ImportError:
-        # TODO(lead): remove once tailbeam.coupled and tailbeam.plate are part of the build.
-        raise InputError("plate.model", "the modal plate is not available in this build") from None
-    m = scene.modal
-    basis = compute_modes(
-        scene.plate,
-        m.boundary,
-        theory=m.theory,
-        fmax_hz=m.fmax_hz,
-        divisions=m.mesh_divisions,
-    )
-    return simulate_coupled(
-        scene.balls,
-        basis,
-        scene.laws(),
-        scene.duration,
-        sensors=scene.sensors,
-        damping_ratio=m.damping_ratio,
-        rayleigh=m.rayleigh,
-        residual_flexibility=m.residual_flexibility,
-        coupling=m.coupling,
-    )
+    from tailbeam.coupled import simulate_scene_modal
+
+    # The modal path chooses its band from the scene (contact durations, sensor bandwidths),
+    # the theory from the band, and records both choices in result.info.
+    return simulate_scene_modal(scene)
 
 
 def write_results(out_dir, scene, result) -> list:

@@ -1,0 +1,19 @@
+"""Balls on a flexible (modal) plate, two-way coupled; see ``simulate_coupled``.
+
+Public API:
+    simulate_coupled(balls, basis, laws, duration, *, sensors=(), ...) -> CoupledResult
+    simulate_scene_modal(scene) -> CoupledResult   (builds the modal basis from the scene)
+"""
+
+from tailbeam.coupled.auto import choose_band, simulate_scene_modal
+from tailbeam.coupled.result import CoupledResult
+from tailbeam.coupled.solver import DEFAULT_DAMPING_RATIO, modal_damping, simulate_coupled
+
+__all__ = [
+    "CoupledResult",
+    "DEFAULT_DAMPING_RATIO",
+    "choose_band",
+    "modal_damping",
+    "simulate_coupled",
+    "simulate_scene_modal",
+]
