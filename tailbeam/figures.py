@@ -86,3 +86,24 @@ def claim_map_figure(path, gaps, dampings, penetrations, pass_count, n_claims, d
     fig.colorbar(mesh, ax=axes, label=f"claims holding (of {n_claims}); * = all; x = defaults")
     fig.savefig(path, dpi=110)
     return Path(path)
+
+
+def sensor_figure(output, path) -> Path:
+    """One sensor's record: sampled acceleration vs time beside its amplitude spectrum (up to
+    the sensor's bandwidth). ``output`` is a tailbeam.sensor.SensorOutput."""
+    fig = Figure(figsize=(10.0, 3.6), layout="constrained")
+    ax_t, ax_f = fig.subplots(1, 2)
+    ax_t.plot(output.t * 1e3, output.acceleration, lw=0.6)
+    ax_t.set_xlabel("time t (ms)")
+    ax_t.set_ylabel("acceleration (m/s$^2$)")
+    ax_t.set_title(f"sensor {output.name}: {output.chain.sample_rate:g} Hz samples", fontsize=9)
+    ax_f.semilogy(output.freq / 1e3, np.maximum(output.amplitude, 1e-9), lw=0.6)
+    ax_f.set_xlim(0.0, output.chain.bandwidth_hz / 1e3)
+    ax_f.set_xlabel("frequency (kHz)")
+    ax_f.set_ylabel("amplitude (m/s$^2$)")
+    ax_f.set_title(f"spectrum, usable band to {output.chain.bandwidth_hz:g} Hz", fontsize=9)
+    for ax in (ax_t, ax_f):
+        ax.grid(alpha=0.3)
+    path = Path(path)
+    fig.savefig(path, dpi=120)
+    return path

@@ -143,6 +143,18 @@ def write_sensors_csv(path, sensor_signals: dict) -> Path:
     return write_csv(path, header, zip(*cols, strict=True))
 
 
+def write_sensor_spectra_csv(path, sensor_outputs: dict) -> Path:
+    """One-sided amplitude spectra (m/s^2 peak) of every sensor: columns freq_<name>,
+    amp_<name> per sensor (their frequency grids differ with sample rate and length)."""
+    header, cols = [], []
+    n = max(len(out.freq) for out in sensor_outputs.values())
+    for name, out in sensor_outputs.items():
+        pad = np.full(n - len(out.freq), np.nan)
+        header += [f"freq_{name}", f"amp_{name}"]
+        cols += [np.concatenate([out.freq, pad]), np.concatenate([out.amplitude, pad])]
+    return write_csv(path, header, zip(*cols, strict=True))
+
+
 def write_claims(out_dir, claims, *, stem: str = "claims") -> tuple[Path, Path]:
     """<stem>.csv and <stem>.md: one row per claim with PASS/FAIL and the numbers behind it."""
     out_dir = Path(out_dir)

@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tailbeam.results_io import IMPACT_COLUMNS
@@ -128,6 +129,20 @@ def test_modal_scene_writes_sensors(tmp_path):
     assert header == ["t", "acc_centre", "acc_edge"]
     t = [float(r[0]) for r in rows]
     assert t[1] - t[0] == pytest.approx(1 / 51200.0)
+    # the spectrum file holds each sensor's one-sided amplitude spectrum of the sampled series
+    spec_header, spec_rows = read_csv(out / "sensor_spectra.csv")
+    assert spec_header == ["freq_acc_centre", "amp_acc_centre", "freq_acc_edge", "amp_acc_edge"]
+    a = np.array([float(r[1]) for r in rows])
+    amp = np.abs(np.fft.rfft(a)) / len(a)
+    amp[1:] *= 2.0
+    if len(a) % 2 == 0:
+        amp[-1] *= 0.5
+    got = np.array([float(r[1]) for r in spec_rows[: len(amp)]])
+    np.testing.assert_allclose(got, amp, rtol=1e-9, atol=1e-12 * amp.max())
+    freq = np.array([float(r[0]) for r in spec_rows[: len(amp)]])
+    np.testing.assert_allclose(freq, np.fft.rfftfreq(len(a), 1 / 51200.0), rtol=1e-12)
+    for name in ("acc_centre", "acc_edge"):
+        assert (out / f"sensor_{name}.png").stat().st_size > 0
 
 
 def test_reproduce(tmp_path):

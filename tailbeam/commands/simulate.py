@@ -1,15 +1,18 @@
 """`tailbeam simulate SCENE.toml [--out DIR]`: simulate a scene file and write its results.
 
-Writes impacts.csv, impacts.json and timeseries.csv (and sensors.csv for a modal plate) into
-DIR. Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
+Writes impacts.csv, impacts.json and timeseries.csv into DIR; for a modal plate also
+sensors.csv, sensor_spectra.csv and one sensor_<name>.png (time and spectrum) per sensor.
+Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
 scene is fully validated before the solver runs, and results go through atomic_output_dir.
 """
 
+from tailbeam.figures import sensor_figure
 from tailbeam.output import atomic_output_dir
 from tailbeam.results_io import (
     result_summary,
     write_impacts_csv,
     write_json,
+    write_sensor_spectra_csv,
     write_sensors_csv,
     write_timeseries_csv,
 )
@@ -41,8 +44,13 @@ def write_results(out_dir, scene, result) -> list:
         write_json(out_dir / "impacts.json", result_summary(result, scene_to_dict(scene))),
         write_timeseries_csv(out_dir / "timeseries.csv", result, scene.sample_rate),
     ]
-    if getattr(result, "sensor_signals", None):
+    outputs = getattr(result, "sensor_outputs", None)
+    if outputs:
         files.append(write_sensors_csv(out_dir / "sensors.csv", result.sensor_signals))
+        files.append(write_sensor_spectra_csv(out_dir / "sensor_spectra.csv", outputs))
+        files += [
+            sensor_figure(out, out_dir / f"sensor_{name}.png") for name, out in outputs.items()
+        ]
     return files
 
 
