@@ -9,7 +9,7 @@ calibration against every qualitative claim (tailbeam.claims, benchmarks/claim_m
 """
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from tailbeam.bodies import Ball, Plate
 from tailbeam.materials import COAL, SANDSTONE, Material
@@ -145,11 +145,6 @@ def run_scenario(
 
     scene = SCENARIOS[key].scene(contact, drop_gap=drop_gap, duration=duration)
     return solver(scene.balls, scene.plate, scene.laws(), scene.duration, **solver_options)
-
-
-def with_contact(contact: ContactSettings, **changes) -> ContactSettings:
-    """A copy of ``contact`` with fields changed (e.g. clamp=False)."""
-    return replace(contact, **changes)
 
 
 def run_all(contact: ContactSettings | None = None, *, drop_gap: float = DROP_GAP, **options):

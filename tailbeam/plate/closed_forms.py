@@ -190,11 +190,6 @@ def leissa_frequencies(plate: Plate, boundary: str) -> np.ndarray | None:
     return np.asarray(table.lambdas) * scale / (2.0 * np.pi)
 
 
-def leissa_table(boundary: str) -> LeissaTable | None:
-    """The table for a boundary code (exact key), or None."""
-    return LEISSA_SQUARE.get(boundary)
-
-
 def ssss_static_compliance(
     plate: Plate, points, contact_radius: float, theory: str, *, terms: int = 600
 ) -> np.ndarray:

@@ -94,11 +94,6 @@ class PlateModel:
         out[self.free_dofs] = x
         return out
 
-    def full_deflection_dofs(self, x) -> np.ndarray:
-        """The deflection-basis DOFs (deflection_basis.N, ...) of free-DOF vector(s) x."""
-        full = self.expand(x)
-        return full[self.w_offset : self.w_offset + self.deflection_basis.N]
-
     def deflection_operator(self, points) -> sp.csr_matrix:
         """(p, n) sparse matrix: deflection (m) at points (p, 2) from free-DOF vectors."""
         pts = check_points(self.plate, points)

@@ -78,6 +78,20 @@ def dop853_tables():
 
 
 @njit(cache=True)
+def _stages(K, A, first, stop, y0, y1, h, ramp, clamped, par):
+    """Runge-Kutta stages first..stop-1 of the state (delta, u) into K (rows: stages)."""
+    for s in range(first, stop):
+        s0 = 0.0
+        s1 = 0.0
+        for j in range(s):
+            s0 += A[s, j] * K[j, 0]
+            s1 += A[s, j] * K[j, 1]
+        uu = y1 + h * s1
+        K[s, 0] = uu
+        K[s, 1] = accel(y0 + h * s0, uu, ramp, clamped, par)
+
+
+@njit(cache=True)
 def integrate_contact(
     par, v_in, tau_max, rtol, atol0, atol1, h0, h_max, max_steps,
     A, B, C, E3, E5, D,
@@ -126,15 +140,7 @@ def integrate_contact(
         # --- one DOP853 step (autonomous system) ---
         K[0, 0] = f0
         K[0, 1] = f1
-        for s in range(1, 12):
-            s0 = 0.0
-            s1 = 0.0
-            for j in range(s):
-                s0 += A[s, j] * K[j, 0]
-                s1 += A[s, j] * K[j, 1]
-            uu = y1 + h * s1
-            K[s, 0] = uu
-            K[s, 1] = accel(y0 + h * s0, uu, ramp, clamped, par)
+        _stages(K, A, 1, 12, y0, y1, h, ramp, clamped, par)
         b0 = 0.0
         b1 = 0.0
         for j in range(12):
@@ -165,15 +171,7 @@ def integrate_contact(
             continue
         nsteps += 1
         # --- dense output (3 extra stages) ---
-        for s in range(13, 16):
-            s0 = 0.0
-            s1 = 0.0
-            for j in range(s):
-                s0 += A[s, j] * K[j, 0]
-                s1 += A[s, j] * K[j, 1]
-            uu = y1 + h * s1
-            K[s, 0] = uu
-            K[s, 1] = accel(y0 + h * s0, uu, ramp, clamped, par)
+        _stages(K, A, 13, 16, y0, y1, h, ramp, clamped, par)
         nfev += 3
         for q in range(2):
             yq_old = y0 if q == 0 else y1

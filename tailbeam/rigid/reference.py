@@ -25,12 +25,12 @@ from tailbeam.rigid.model import (
     make_pairs,
 )
 
-CHUNK = 400.0
+CHUNK = 400.0  # integrate at most this many contact time scales per solve_ivp call
 _SAME_FUNCTION = {
     "full_damping": ("full_damping",),
     "clamp_on": ("clamp",),
     "clamp_off": ("clamp",),
-}  # integrate at most this many contact time scales per solve_ivp call
+}
 
 
 def simulate_rigid_reference(
