@@ -13,6 +13,10 @@ class InputError(ValueError):
         self.rule = rule
         super().__init__(f"{field}: {rule}")
 
+    def renamed(self, names: dict) -> "InputError":
+        """The same error under the caller's name of the field, e.g. {"fmax_hz": "--fmax"}."""
+        return InputError(names.get(self.field, self.field), self.rule)
+
 
 class WorkLimitError(RuntimeError):
     """A bounded computation hit its limit (steps, contacts, events). The message says which

@@ -95,6 +95,12 @@ class ModalPlateSettings:
         if self.coupling not in COUPLINGS:
             raise InputError("plate.coupling", f"must be one of {COUPLINGS}, got {self.coupling!r}")
         require_nonnegative("plate.damping_ratio", self.damping_ratio)
+        if self.damping_ratio >= 1.0:
+            raise InputError(
+                "plate.damping_ratio",
+                f"must be < 1 (an underdamped plate; welded steel is ~0.001-0.05), "
+                f"got {self.damping_ratio!r}",
+            )
         if self.rayleigh is not None:
             alpha, beta = require_vector("plate.rayleigh", self.rayleigh, 2)
             require_nonnegative("plate.rayleigh[0]", alpha)

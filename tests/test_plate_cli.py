@@ -15,6 +15,7 @@ def test_modes_command_writes_outputs(tmp_path, monkeypatch, capsys):
     out = tmp_path / "out"
     code = main(
         ["modes", "--count", "6", "--theory", "kirchhoff", "--divisions", "8", "--out", str(out)]
+        + ["--vtu", "--png"]
     )
     assert code == 0
     printed = capsys.readouterr().out
@@ -36,5 +37,28 @@ def test_bad_boundary_code_is_one_line_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "out"
     code = main(["modes", "--bc", "SSQS", "--out", str(out)])
     err = capsys.readouterr().err
-    assert code == 2 and err.count("\n") == 1 and "boundary" in err
+    assert code == 2 and err.count("\n") == 1 and "--bc" in err
     assert not out.exists()
+
+
+def test_default_output_is_frequencies_only(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("TAILBEAM_CACHE_DIR", str(tmp_path / "cache"))
+    out = tmp_path / "out"
+    code = main(
+        ["modes", "--count", "3", "--theory", "kirchhoff", "--divisions", "6", "--out", str(out)]
+    )
+    assert code == 0
+    assert sorted(p.name for p in out.iterdir()) == ["frequencies.csv"]
+
+
+def test_too_large_band_names_the_option_before_work(tmp_path, capsys):
+    # fmax: the mesh the band needs is beyond the mesh limit; count: the estimated solve is
+    # far beyond the memory/time limits (tailbeam.plate.cost). Both refused before assembly.
+    for option, value in (("--fmax", "1e6"), ("--fmax", "72000"), ("--count", "5000")):
+        out = tmp_path / "out"
+        code = main(["modes", option, value, "--no-cache", "--out", str(out)])
+        err = capsys.readouterr().err
+        assert code == 2 and err.count("\n") == 1, err
+        assert err.startswith(f"tailbeam modes: error: {option}:"), err
+        assert "divisions:" not in err
+        assert not out.exists()

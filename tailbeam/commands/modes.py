@@ -3,13 +3,26 @@
 Prints a table with the analytic or published references and the relative errors where they
 exist (SSSS: closed forms of both theories; two opposite edges S: Levy's exact Kirchhoff
 solution; square CCCC/FFFF/CFFF: Leissa, Kirchhoff), and writes frequencies.csv (first
-reference only), modes.vtu (ParaView) and modes.png into --out (atomically).
+reference only) into --out (atomically); modes.vtu (ParaView) with --vtu and modes.png with
+--png (figures and VTU cost more than a cached solve: only what is asked for is written).
+Bad input names the option (--fmax, --count, --divisions, ...), also when the band is too
+costly to compute (tailbeam.plate.cost, estimated before anything is assembled).
 """
 
 from tailbeam.bodies import Plate
 from tailbeam.errors import InputError
 from tailbeam.materials import get_material
 from tailbeam.output import atomic_output_dir
+
+CLI_FIELDS = {
+    "fmax_hz": "--fmax",
+    "count": "--count",
+    "divisions": "--divisions",
+    "accuracy": "--accuracy",
+    "theory": "--theory",
+    "mesh": "--mesh",
+    "boundary": "--bc",
+}
 
 
 def add_arguments(parser):
@@ -50,6 +63,8 @@ def add_arguments(parser):
         help="plate size a, b and thickness h in m",
     )
     parser.add_argument("--no-cache", action="store_true", help="neither read nor write cache")
+    parser.add_argument("--vtu", action="store_true", help="also write modes.vtu (ParaView)")
+    parser.add_argument("--png", action="store_true", help="also write modes.png (mode shapes)")
     parser.add_argument("--out", default="out/modes", help="output directory")
 
 
@@ -78,24 +93,26 @@ def reference_frequencies(basis):
 
 def run(args) -> int:
     from tailbeam.plate import compute_modes
-    from tailbeam.plate.export import write_frequencies_csv, write_png, write_vtu
 
     if args.count is not None and args.count < 1:
-        raise InputError("count", f"must be >= 1, got {args.count}")
-    material = get_material(args.material, field="material")
+        raise InputError("--count", f"must be >= 1, got {args.count}")
+    material = get_material(args.material, field="--material")
     a, b, h = args.size
     plate = Plate(material=material, size_x=a, size_y=b, thickness=h)
-    basis = compute_modes(
-        plate,
-        args.bc,
-        theory=args.theory,
-        fmax_hz=args.fmax,
-        count=args.count,
-        mesh=args.mesh,
-        divisions=args.divisions,
-        accuracy=args.accuracy,
-        use_cache=not args.no_cache,
-    )
+    try:
+        basis = compute_modes(
+            plate,
+            args.bc,
+            theory=args.theory,
+            fmax_hz=args.fmax,
+            count=args.count,
+            mesh=args.mesh,
+            divisions=args.divisions,
+            accuracy=args.accuracy,
+            use_cache=not args.no_cache,
+        )
+    except InputError as err:
+        raise err.renamed(CLI_FIELDS) from None
     refs = reference_frequencies(basis)
     info = basis.info
     print(
@@ -117,12 +134,24 @@ def run(args) -> int:
         print(line)
     for i, (label, _) in enumerate(refs):
         print(f"ref{i + 1}: {label}")
+    _write(args, basis, refs)
+    return 0
+
+
+def _write(args, basis, refs) -> None:
+    """frequencies.csv, and modes.vtu / modes.png when asked for, into --out (atomically)."""
+    from tailbeam.plate import export
+
     ref, ref_name = refs[0][1] if refs else None, refs[0][0] if refs else ""
+    names = ["frequencies.csv"]
     with atomic_output_dir(args.out) as tmp:
-        write_frequencies_csv(
+        export.write_frequencies_csv(
             tmp / "frequencies.csv", basis.frequencies_hz, basis.theory, ref, ref_name
         )
-        write_vtu(tmp / "modes.vtu", basis)
-        write_png(tmp / "modes.png", basis)
-    print(f"wrote frequencies.csv, modes.vtu, modes.png to {args.out}")
-    return 0
+        if args.vtu:
+            export.write_vtu(tmp / "modes.vtu", basis)
+            names.append("modes.vtu")
+        if args.png:
+            export.write_png(tmp / "modes.png", basis)
+            names.append("modes.png")
+    print(f"wrote {', '.join(names)} to {args.out}")

@@ -1,14 +1,33 @@
-"""Model only what the scene needs: the modal band, then the run, from a Scene.
+"""Model only what the scene needs: the modal band, its cost, then the run, from a Scene.
 
-Band. Two things need modes: the contacts and the sensors.
-- A contact of duration T (Hertz estimate at the largest impact speed the ball can reach,
-  tailbeam.hertz) is a pulse whose spectrum falls like 1/((2 f T)^2 - 1) above 1/T (half-sine
-  envelope). Modes above ``CONTACT_BAND_FACTOR`` / T_min are driven less than ~0.6 % as hard
-  as the low ones; they still matter locally as compliance, which the residual flexibility adds.
-- A sensor sees modes up to its bandwidth.
-fmax = max(CONTACT_BAND_FACTOR / T_min, max sensor bandwidth). The user's [plate] fmax overrides.
-Theory: tailbeam.plate.compute_modes(theory="auto") picks Kirchhoff or Mindlin from the band.
-The estimated truncation error is reported in ``result.info["band"]``.
+Band. Two outputs need modes: the sensor signals and the contact forces.
+- A sensor cannot see above its bandwidth: the band reaches the largest sensor bandwidth.
+- A contact of duration T (Hertz, at the hardest impact speed the ball can reach) is stiffened
+  by the modes left out only through their compliance, which the residual flexibility adds
+  quasi-statically. A mode of frequency f above 1/T responds to the pulse (dominant angular
+  frequency pi/T) with a dynamic excess 1/((2 f T)^2 - 1) over F/omega^2, so treating every
+  mode above fc quasi-statically misses C_res(fc) g(2 fc T) of compliance, with
+  g(u) = (u/2) ln((u+1)/(u-1)) - 1 ~ 1/(3 u^2) (the 1/f^2 weight of the modal sum over the
+  near-constant modal density of a plate). C_res(fc), the static compliance of the modes
+  above fc, is the infinite thin plate's 1 / (8 pi^2 fc sqrt(rho h D)) times
+  RESIDUAL_SAFETY (clamped edges and Mindlin's shear raise it; tests/test_band.py checks it
+  against the SSSS closed form). Against the Hertz contact's own secant compliance
+  C_c = delta_m / F_m, the peak force moves by about half the relative compliance error, so
+      force error(fc) ~ RESIDUAL_SAFETY / 2 * C_res(fc) g(2 fc T) / C_c   (falls like fc^-3)
+  and the contacts need the smallest fc with force error <= ``BAND_ACCURACY``. Without
+  residual flexibility the modes above fc are simply missing: error ~ C_res(fc) / (2 C_c).
+fmax = max(sensor bandwidth, contact band). The user's [plate] fmax overrides.
+
+Assumption for the sensors (stated in result.info["band"]["sensor_note"]): with fmax at the
+bandwidth every mode a sensor can see is kept; the modes above fmax reach a sensor only
+through their quasi-static (local) response, which is small a wavelength away from the
+contacts and which the mode-acceleration correction of issue 9 adds at the sensors. Once it
+is in, nothing here changes: the sensor band stays the bandwidth and the contact band is
+already set by the residual flexibility at the contacts.
+
+Cost. Before anything is assembled the basis's DOFs, modes, memory and time are estimated
+(tailbeam.plate.cost) and a band over the limits is refused naming ``plate.fmax``.
+Theory and mesh: tailbeam.plate.compute_modes(theory="auto") picks them from the band.
 """
 
 import math
@@ -16,68 +35,159 @@ import math
 from tailbeam.bodies import STANDARD_GRAVITY
 from tailbeam.coupled.solver import simulate_coupled
 from tailbeam.errors import InputError
-from tailbeam.hertz import hertz_contact_duration
+from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration
 from tailbeam.scene import ModalPlateSettings, Scene
 from tailbeam.sensor import resolve
 
-CONTACT_BAND_FACTOR = 6.0  # fmax >= 6 / T_contact (measured: 1e-4 error with residual)
+BAND_ACCURACY = 1e-3  # target relative peak-force error from the band (the outputs need 1 %)
+RESIDUAL_SAFETY = 2.0  # on the infinite-plate residual compliance
+MIN_CONTACT_BAND_FACTOR = 1.0  # fc >= 1 / T: modes below 1/T respond dynamically
+SCENE_FIELDS = {"fmax_hz": "plate.fmax", "divisions": "plate.mesh_divisions"}
 
 
 def contact_durations(scene: Scene, gravity: float = STANDARD_GRAVITY) -> dict:
     """Hertz contact duration (s) of each ball's hardest impact: the speed after falling from
     its start, sqrt(vz^2 + 2 g gap); elastic rebounds never exceed it."""
+    return {name: c["duration_s"] for name, c in _contacts(scene, gravity).items()}
+
+
+def _contacts(scene: Scene, gravity: float = STANDARD_GRAVITY) -> dict:
+    """Per ball: hardest impact speed (m/s), Hertz duration (s), secant compliance (m/N)."""
     out = {}
     for ball, law in zip(scene.balls, scene.laws(), strict=True):
         speed = math.sqrt(ball.velocity[2] ** 2 + 2 * gravity * max(ball.gap, 0.0))
         speed = max(speed, 1e-3)
-        out[ball.name] = hertz_contact_duration(ball.mass, speed, law.stiffness, law.exponent)
+        delta = hertz_max_penetration(ball.mass, speed, law.stiffness, law.exponent)
+        out[ball.name] = {
+            "speed_m_s": speed,
+            "duration_s": hertz_contact_duration(ball.mass, speed, law.stiffness, law.exponent),
+            "compliance_m_n": delta / (law.stiffness * delta**law.exponent),
+        }
     return out
+
+
+def residual_compliance_estimate(plate, f_cut_hz: float) -> float:
+    """Static compliance (m/N) of the modes above ``f_cut_hz`` at a point: the infinite thin
+    plate's 1 / (8 pi^2 f sqrt(rho h D)) (constant modal density A/2 sqrt(rho h/D), mean
+    squared unit-mass shape 1/(rho h A)), without the safety factor."""
+    return 1.0 / (
+        8.0 * math.pi**2 * f_cut_hz * math.sqrt(plate.mass_per_area * plate.bending_stiffness)
+    )
+
+
+def _dynamic_fraction(u):
+    """Compliance the quasi-static treatment misses, as a fraction of C_res(fc), u = 2 fc T:
+    the modal sum's 1/f^2 weight times each mode's dynamic excess 1/(u^2 - 1) above fc,
+    integrated: (u/2) ln((u+1)/(u-1)) - 1 (~ 1/(3 u^2) for large u)."""
+    return 0.5 * u * math.log((u + 1.0) / (u - 1.0)) - 1.0
+
+
+def force_error_estimate(plate, f_cut_hz, duration_s, compliance, residual=True) -> float:
+    """Estimated relative peak-force error when the band stops at ``f_cut_hz`` (module doc)."""
+    c_res = RESIDUAL_SAFETY * residual_compliance_estimate(plate, f_cut_hz)
+    if not residual:
+        return 0.5 * c_res / compliance
+    u = 2.0 * f_cut_hz * duration_s
+    if u <= 1.0:
+        return math.inf  # the band stops below the pulse's own frequency
+    return 0.5 * c_res * _dynamic_fraction(u) / compliance
+
+
+def contact_band(plate, duration_s, compliance, accuracy=BAND_ACCURACY, residual=True) -> float:
+    """Smallest band (Hz), at least MIN_CONTACT_BAND_FACTOR / T, whose force_error_estimate
+    is ``accuracy`` (the estimate falls monotonically with the band)."""
+    from scipy.optimize import brentq
+
+    lo = MIN_CONTACT_BAND_FACTOR / duration_s
+    if force_error_estimate(plate, lo, duration_s, compliance, residual) <= accuracy:
+        return lo
+    hi = 2.0 * lo
+    while force_error_estimate(plate, hi, duration_s, compliance, residual) > accuracy:
+        hi *= 2.0
+    return brentq(
+        lambda f: force_error_estimate(plate, f, duration_s, compliance, residual) - accuracy,
+        lo,
+        hi,
+        rtol=1e-6,
+    )
 
 
 def choose_band(scene: Scene, settings: ModalPlateSettings | None = None) -> dict:
     """The modal band for ``scene``: fmax (Hz) with the reasons and the estimated errors."""
     settings = settings or scene.modal or ModalPlateSettings()
-    durations = contact_durations(scene)
-    t_min = min(durations.values())
-    f_contact = CONTACT_BAND_FACTOR / t_min
+    residual = settings.residual_flexibility
+    contacts = _contacts(scene)
+    needs = {
+        name: contact_band(scene.plate, c["duration_s"], c["compliance_m_n"], residual=residual)
+        for name, c in contacts.items()
+    }
+    hardest = max(needs, key=needs.get)
+    f_contact = needs[hardest]
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
     chosen = max(f_contact, f_sensor)
     fmax = settings.fmax_hz if settings.fmax_hz is not None else chosen
-    x = 2.0 * fmax * t_min
-    level = 1.0 / (x * x - 1.0) if x > 1.0 else 1.0
+    errors = {
+        name: force_error_estimate(
+            scene.plate, fmax, c["duration_s"], c["compliance_m_n"], residual=residual
+        )
+        for name, c in contacts.items()
+    }
     return {
-        "fmax_hz": fmax,
+        "fmax_hz": float(fmax),
         "user_fmax": settings.fmax_hz is not None,
-        "contact_duration_min_s": t_min,
-        "fmax_contact_hz": f_contact,
-        "fmax_sensors_hz": f_sensor,
-        # relative force-spectrum level at fmax: how hard the first left-out mode is driven
-        "truncation_force_level": level,
-        "sensor_band_covered": fmax >= f_sensor,
+        "reason": _reason(settings, f_contact, f_sensor, hardest),
+        "accuracy": BAND_ACCURACY,
+        "contact_duration_min_s": min(c["duration_s"] for c in contacts.values()),
+        "fmax_contact_hz": float(f_contact),
+        "fmax_sensors_hz": float(f_sensor),
+        "hardest_contact": hardest,
+        # estimated relative peak-force error from the band, worst ball
+        "truncation_force_error": float(max(errors.values())),
+        "sensor_band_covered": bool(fmax >= f_sensor),
+        "sensor_note": (
+            "modes above fmax reach the sensors only quasi-statically (not included until "
+            "the mode-acceleration correction, issue 9)"
+        ),
     }
 
 
+def _reason(settings, f_contact, f_sensor, hardest) -> str:
+    if settings.fmax_hz is not None:
+        return "plate.fmax set in the scene"
+    if f_sensor >= f_contact:
+        return f"sensor bandwidth {f_sensor / 1e3:.1f} kHz (contacts need {f_contact / 1e3:.1f})"
+    return (
+        f"contact of {hardest}: {f_contact / 1e3:.1f} kHz for a peak-force error "
+        f"<= {BAND_ACCURACY:g} (sensors need {f_sensor / 1e3:.1f})"
+    )
+
+
 def build_basis(scene: Scene, band: dict | None = None, *, use_cache: bool = True):
-    """The modal basis of the scene's plate (tailbeam.plate.compute_modes) for the band."""
+    """The modal basis of the scene's plate (tailbeam.plate.compute_modes) for the band;
+    a band too costly to compute is refused naming plate.fmax."""
     settings = scene.modal or ModalPlateSettings()
     band = band or choose_band(scene, settings)
     from tailbeam.plate import compute_modes
 
-    return compute_modes(
-        scene.plate,
-        settings.boundary,
-        theory=settings.theory,
-        fmax_hz=band["fmax_hz"],
-        divisions=settings.mesh_divisions,
-        use_cache=use_cache,
-    )
+    try:
+        return compute_modes(
+            scene.plate,
+            settings.boundary,
+            theory=settings.theory,
+            fmax_hz=band["fmax_hz"],
+            divisions=settings.mesh_divisions,
+            use_cache=use_cache,
+        )
+    except InputError as err:
+        raise err.renamed(SCENE_FIELDS) from None
 
 
 def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **options):
     """Run a scene on the modal plate: choose the band, build (or take) the basis, simulate.
 
     ``options`` go to simulate_coupled (e.g. steps_per_contact). The band and the basis's
-    description are in result.info["band"] and result.info["basis"]."""
+    description are in result.info["band"] and result.info["basis"]; describe_choices(info)
+    says it in one line."""
     if not isinstance(scene, Scene):
         raise InputError("scene", "must be a tailbeam.scene.Scene")
     settings = scene.modal or ModalPlateSettings()
@@ -104,4 +214,26 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
         "top_frequency_hz": float(basis.frequencies_hz[-1]),
         **{k: v for k, v in basis.info.items() if isinstance(v, (str, int, float, bool))},
     }
+    cost = basis.info.get("cost_estimate")
+    if isinstance(cost, dict):
+        result.info["basis"]["cost_estimate"] = cost
     return result
+
+
+def describe_choices(info: dict) -> str:
+    """One line of what was chosen automatically, from a modal result's ``info``."""
+    band, basis = info.get("band", {}), info.get("basis", {})
+    if not band:
+        return "rigid plate: no modal band"
+    parts = [f"band 0-{band['fmax_hz'] / 1e3:.1f} kHz ({band['reason']})"]
+    if basis:
+        mesh = f", {basis['divisions']} divisions" if basis.get("divisions") else ""
+        parts.append(
+            f"{basis['theory']}{mesh}, {basis['n_modes']} modes"
+            + (f", {basis['n_dofs']} DOFs" if "n_dofs" in basis else "")
+            + (f", basis cache {basis['cache']}" if "cache" in basis else "")
+        )
+    parts.append(f"est. peak-force truncation error {band['truncation_force_error']:.1e}")
+    if not band["sensor_band_covered"]:
+        parts.append("band below a sensor's bandwidth")
+    return "; ".join(parts)

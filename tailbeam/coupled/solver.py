@@ -40,9 +40,12 @@ def modal_damping(omega, damping_ratio=DEFAULT_DAMPING_RATIO, rayleigh=None) -> 
         alpha, beta = rayleigh
         if alpha < 0 or beta < 0:
             raise InputError("plate.rayleigh", "alpha and beta must be >= 0")
-        return alpha / (2.0 * omega) + 0.5 * beta * omega
-    if damping_ratio < 0:
-        raise InputError("plate.damping_ratio", f"must be >= 0, got {damping_ratio!r}")
+        zeta = alpha / (2.0 * omega) + 0.5 * beta * omega
+        if np.any(zeta >= 1.0):
+            raise InputError("plate.rayleigh", "gives a damping ratio >= 1 for some mode")
+        return zeta
+    if not 0 <= damping_ratio < 1:
+        raise InputError("plate.damping_ratio", f"must be in [0, 1), got {damping_ratio!r}")
     return np.full(omega.shape, float(damping_ratio))
 
 

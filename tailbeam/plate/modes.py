@@ -17,25 +17,28 @@ from tailbeam.modal import ModalBasis
 from tailbeam.plate import cache as modal_cache
 from tailbeam.plate.boundary import EDGES, describe, parse_boundary, rigid_body_mode_count
 from tailbeam.plate.closed_forms import bending_wavenumber, ssss_kirchhoff_frequencies
+from tailbeam.plate.cost import SolveCost, check_cost, mesh_dofs, solve_cost
 from tailbeam.plate.mindlin import DEFAULT_DEGREE
 from tailbeam.plate.model import PlateModel, assemble_plate, check_points, resolve_mesh
 from tailbeam.plate.resolution import DEFAULT_FMAX_HZ, resolve
 from tailbeam.plate.sparse_solve import count_eigenvalues_below, lowest_modes
+from tailbeam.progress import task
 
+MAX_COUNT = 10_000  # modes: far beyond any band this package is meant for
 MAX_SOLVE_ROUNDS = 5  # enlarging the number of requested modes until the band is covered
 _WEYL_EDGE = {"S": -1.0, "C": -1.0, "F": 1.0}  # boundary term per edge, in units of L k/(4 pi)
 
 
 def _blas_threads(requested):
     """Thread limit for BLAS inside the solve: the keyword, else $TAILBEAM_BLAS_THREADS, else
-    1 under a pytest-xdist worker (two workers x two BLAS threads on two cores slows eigsh
-    several-fold), else no limit (None)."""
+    1. The shift-invert solves (SuperLU) are single-threaded anyway; more BLAS threads only
+    speed up the Lanczos orthogonalisation, and on a loaded machine they slowed the whole
+    solve several-fold (default plate to 10 kHz: 23 s with two OpenBLAS threads, 3 s with one;
+    NOTES-band.md)."""
     if requested is not None:
         return int(requested)
     env = os.environ.get("TAILBEAM_BLAS_THREADS")
-    if env:
-        return int(env)
-    return 1 if os.environ.get("PYTEST_XDIST_WORKER") else None
+    return int(env) if env else 1
 
 
 def _estimated_count(plate: Plate, boundary: str, theory: str, fmax_hz: float) -> int:
@@ -58,12 +61,14 @@ def _check_request(plate, theory, fmax_hz, count):
         isinstance(count, bool) or not isinstance(count, Integral) or count < 1
     ):
         raise InputError("count", f"must be a whole number >= 1, got {count!r}")
+    if count is not None and count > MAX_COUNT:
+        raise InputError("count", f"must be <= {MAX_COUNT}, got {count!r}")
     if fmax_hz is None and count is None:
         fmax_hz = DEFAULT_FMAX_HZ
     return fmax_hz, None if count is None else int(count)
 
 
-def _solve_band(model, boundary, fmax_hz, count):
+def _solve_band(model, boundary, fmax_hz, count, on_solve=None):
     """Elastic eigenpairs (lambda, phi) covering the band, rigid-body modes removed."""
     rigid = rigid_body_mode_count(boundary)
     f_scale = float(ssss_kirchhoff_frequencies(model.plate, 1, 1))
@@ -75,7 +80,7 @@ def _solve_band(model, boundary, fmax_hz, count):
         wanted = min(wanted, count)
     for _ in range(MAX_SOLVE_ROUNDS):
         nev = min(wanted + rigid, model.n_dofs)
-        lam, phi = lowest_modes(model.stiffness, model.mass, nev, shift=shift)
+        lam, phi = lowest_modes(model.stiffness, model.mass, nev, shift=shift, on_solve=on_solve)
         omega = np.sqrt(np.abs(lam)) * np.sign(lam)
         if rigid:
             # rigid-body modes: numerically zero next to the first elastic frequency
@@ -108,6 +113,19 @@ def _solve_band(model, boundary, fmax_hz, count):
         f"the band up to {fmax_hz} Hz was not covered after {MAX_SOLVE_ROUNDS} enlargements "
         f"of the eigen-solve ({wanted} modes); ask for fewer modes (count=) or a lower fmax_hz"
     )
+
+
+def _solve_cost(plate, boundary, res, mesh, fmax_hz, count, degree) -> SolveCost:
+    """The estimated work of the solve; InputError naming fmax_hz / count above the limits."""
+    n_modes = _estimated_count(plate, boundary, res.theory, res.top_frequency_hz)
+    if count is not None:
+        n_modes = min(n_modes, count)
+    cost = solve_cost(mesh_dofs(mesh, res.theory, degree), n_modes)
+    if fmax_hz is not None:
+        check_cost(cost, "fmax_hz", f"the band up to {fmax_hz:.0f} Hz")
+    else:
+        check_cost(cost, "count", f"the first {count} modes")
+    return cost
 
 
 def _probe_basis(mesh: MeshTri, theory: str, degree: int) -> Basis:
@@ -255,6 +273,7 @@ def compute_modes(
                 info,
                 degree=mindlin_degree,
             )
+    cost = _solve_cost(plate, boundary, res, mesh_obj, fmax_hz, count, mindlin_degree)
     threads = _blas_threads(blas_threads)
     with threadpool_limits(limits=threads):
         t0 = time.perf_counter()
@@ -262,7 +281,8 @@ def compute_modes(
             plate, boundary, theory=res.theory, mesh=mesh_obj, mindlin_degree=mindlin_degree
         )
         t1 = time.perf_counter()
-        freqs, phi = _solve_band(model, boundary, fmax_hz, count)
+        with task(f"eigen-solve, {cost.describe()}", unit="solves") as bar:
+            freqs, phi = _solve_band(model, boundary, fmax_hz, count, on_solve=bar.update)
         t2 = time.perf_counter()
     if len(freqs) == 0:
         raise InputError(
@@ -296,6 +316,7 @@ def compute_modes(
         "assembly_s": t1 - t0,
         "eigensolve_s": t2 - t1,
         "blas_threads": threads,
+        "cost_estimate": cost.as_dict(),
         "cache": "off" if not use_cache else "miss",
         "cache_file": str(path) if use_cache else None,
     }

@@ -26,7 +26,7 @@ from tailbeam.plate.closed_forms import (
     kirchhoff_model_error,
     ssss_modes,
 )
-from tailbeam.plate.mesh import grid_divisions
+from tailbeam.plate.mesh import MAX_DIVISIONS, grid_divisions
 
 DEFAULT_FMAX_HZ = 10_000.0
 SAFETY = 2.0
@@ -111,6 +111,12 @@ def resolve(
         why += f"; {divisions} divisions requested"
     else:
         chosen = divisions_for(plate, theory, f_top, budget)
+        if chosen > MAX_DIVISIONS:
+            raise InputError(
+                "fmax_hz" if fmax_hz is not None else "count",
+                f"the band up to {f_top:.0f} Hz needs {chosen} mesh divisions per side for "
+                f"accuracy {accuracy:g} (the limit is {MAX_DIVISIONS}); ask for a lower band",
+            )
         why += (
             f"; {chosen} divisions: predicted discretisation error at {f_top:.0f} Hz "
             f"<= {budget:.1e}"
