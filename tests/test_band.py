@@ -1,0 +1,131 @@
+"""The automatic modal band (tailbeam.coupled.auto): its estimates against independent truths
+(the SSSS closed-form static compliance and exact SSSS modes), its choice, and its refusals."""
+
+import numpy as np
+import pytest
+
+from tailbeam.bodies import Ball, Plate
+from tailbeam.cli import main
+from tailbeam.contact_law import ball_plate_law
+from tailbeam.coupled import auto, simulate_coupled
+from tailbeam.errors import InputError
+from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
+from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.plate.closed_forms import ssss_static_compliance
+from tailbeam.scene_file import loads_scene
+
+PLATE = Plate()
+SCENE = """
+duration = 0.004
+[plate]
+model = "modal"
+{plate}
+[[balls]]
+name = "small"
+material = "sandstone"
+radius = 0.01
+position = [0.05, 0.07, 0.0105]
+velocity = [0.0, 0.0, -3.0]
+[[balls]]
+name = "big"
+material = "coal"
+radius = 0.04
+position = [-0.15, -0.1, 0.0405]
+velocity = [0.0, 0.0, -3.0]
+{sensors}
+"""
+SENSOR = '[[sensors]]\nname = "acc"\nposition = [0.2, 0.2]\nsample_rate = {fs}\n'
+
+
+def scene(plate="", sensors=""):
+    return loads_scene(SCENE.format(plate=plate, sensors=sensors))
+
+
+@pytest.mark.parametrize("f_cut", [5e3, 1e4, 2e4])
+def test_residual_compliance_estimate_matches_ssss_closed_form(f_cut):
+    # Truth: the Navier-series static compliance minus the exact modes below f_cut.
+    pts = np.array([[0.05, 0.07], [-0.12, 0.1], [0.2, -0.15]])
+    basis = ssss_kirchhoff_basis(PLATE, f_cut)
+    full = ssss_static_compliance(PLATE, pts, 0.0, "kirchhoff")
+    truth = full - np.sum(basis.deflection(pts) ** 2 / basis.omega**2, axis=1)
+    ratio = truth / auto.residual_compliance_estimate(PLATE, f_cut)
+    np.testing.assert_allclose(ratio, 1.0, atol=0.1)
+
+
+@pytest.mark.parametrize(("material", "radius"), [(SANDSTONE, 0.01), (COAL, 0.04)])
+def test_force_error_estimate_bounds_the_truncation_error_on_exact_modes(material, radius):
+    # Truth: the same impact on exact SSSS modes up to 16/T (converged: the error falls like
+    # f^-3.3); the band's error is measured against it, with residual flexibility.
+    ball = Ball("b", material, radius, (0.05, 0.07, radius + 1e-4), (0.0, 0.0, -3.0))
+    law = ball_plate_law(material, radius, CARBON_STEEL)
+
+    class OneBall:
+        balls = (ball,)
+
+        def laws(self):
+            return (law,)
+
+    contact = auto._contacts(OneBall(), gravity=0.0)["b"]
+    t_c = contact["duration_s"]
+    full = ssss_kirchhoff_basis(PLATE, 16.0 / t_c)
+
+    def peak(basis):
+        res = simulate_coupled([ball], basis, [law], 2 * t_c, gravity=0.0, steps_per_contact=400)
+        return res.impacts[0].peak_force
+
+    truth = peak(full)
+    for f_cut in (1.0 / t_c, 2.0 / t_c):
+        measured = abs(peak(full.truncated(fmax_hz=f_cut)) / truth - 1.0)
+        estimate = auto.force_error_estimate(PLATE, f_cut, contact)
+        # an upper bound, and not a loose one (measured 0.43-0.74 of it)
+        assert estimate / 4 < measured <= estimate
+
+
+def test_band_is_the_larger_of_sensor_and_contact_needs_and_meets_the_accuracy():
+    contact_only = auto.choose_band(scene())
+    assert contact_only["fmax_sensors_hz"] == 0.0
+    assert contact_only["hardest_contact"] == "small"  # the shortest, stiffest contact
+    f_c = contact_only["fmax_contact_hz"]
+    assert contact_only["fmax_hz"] == f_c
+    assert contact_only["truncation_force_error"] == pytest.approx(auto.BAND_ACCURACY, rel=1e-4)
+    # the smallest such band: 2 % lower misses the accuracy
+    small = auto._contacts(scene())["small"]
+    assert auto.force_error_estimate(PLATE, 0.98 * f_c, small) > auto.BAND_ACCURACY
+    # a sensor with a wider band than the contacts need sets the band ...
+    wide = auto.choose_band(scene(sensors=SENSOR.format(fs=2.56 * 2 * f_c)))
+    assert wide["fmax_hz"] == pytest.approx(2 * f_c) and "sensor bandwidth" in wide["reason"]
+    assert wide["truncation_force_error"] < auto.BAND_ACCURACY
+    # ... and [plate] fmax overrides both, with its estimated error
+    user = auto.choose_band(scene(plate="fmax = 5000.0"))
+    assert user["fmax_hz"] == 5000.0 and user["truncation_force_error"] > auto.BAND_ACCURACY
+
+
+def test_too_costly_band_is_refused_naming_plate_fmax_before_any_work(tmp_path, capsys):
+    for fmax in ("72000.0", "1e6"):
+        with pytest.raises(InputError) as info:
+            auto.build_basis(scene(plate=f"fmax = {fmax}"), use_cache=False)
+        assert info.value.field == "plate.fmax", info.value
+    path = tmp_path / "scene.toml"
+    path.write_text(SCENE.format(plate="fmax = 72000.0", sensors=""))
+    out = tmp_path / "out"
+    assert main(["simulate", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "plate.fmax" in err and "GB" in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("ratio", ["1.0", "50.0"])
+def test_overdamped_plate_is_refused_naming_damping_ratio(ratio):
+    with pytest.raises(InputError) as info:
+        scene(plate=f"damping_ratio = {ratio}")
+    assert info.value.field == "plate.damping_ratio"
+
+
+def test_describe_choices_is_one_line(tmp_path, monkeypatch):
+    monkeypatch.setenv("TAILBEAM_CACHE_DIR", str(tmp_path))
+    s = scene(plate="fmax = 3000.0\nmesh_divisions = 8")
+    res = auto.simulate_scene_modal(s)
+    line = auto.describe_choices(res.info)
+    assert "\n" not in line
+    assert line.startswith("band 0-3.0 kHz (plate.fmax set in the scene)")
+    assert f"{res.basis.n_modes} modes" in line and "8 divisions" in line
