@@ -6,6 +6,7 @@ every event; this driver records the events and impacts, refreshes each ball's c
 grows the node buffers. Everything physical happens in the kernel.
 """
 
+import contextlib
 import math
 
 import numpy as np
@@ -19,6 +20,7 @@ from tailbeam.coupled.result import CoupledResult
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration
 from tailbeam.modal import ModalBasis
+from tailbeam.progress import task
 
 DEFAULT_DAMPING_RATIO = 0.01  # of every mode; README "Defaults" (welded steel, light joints)
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid solver's value, so both models stop alike
@@ -174,6 +176,11 @@ def simulate_coupled(
     evout = np.zeros(2, dtype=np.int64)
     t, total_steps, status, message = 0.0, 0, 0, "reached the end of the simulated time"
     moving = np.hypot(vx, vy) > 0
+    progress = contextlib.ExitStack()  # closed after the loop (no re-indented loop body)
+    bar = progress.enter_context(
+        task(f"simulating {duration:g} s", total=1e3 * duration, unit="ms simulated")
+    )
+    t_shown = 0.0
     while t < duration:
         if len(events) > max_events:
             raise WorkLimitError(f"more than max_events={max_events} events; raise max_events")
@@ -207,6 +214,8 @@ def simulate_coupled(
             evout,
         )
         code, t, nbuf_new, steps = res
+        bar.update(1e3 * (t - t_shown))
+        t_shown = t
         total_steps += steps
         seg_phase.extend([len(phis) - 1] * (nbuf_new - nbuf))
         nbuf = nbuf_new
@@ -293,6 +302,7 @@ def simulate_coupled(
                 nbuf = _append_node(t, z, vz, F, cur, (bt, bz, bvz, bF, bd), nbuf, seg_phase)
             else:
                 h[b] = nominal_step(b, v_out)
+    progress.close()
     for b, info in open_contacts.items():  # contacts still open at the end
         impacts.append(
             close_contact(

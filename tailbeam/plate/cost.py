@@ -69,13 +69,13 @@ def solve_cost(n_dofs: int, n_modes: int) -> SolveCost:
     return SolveCost(int(n_dofs), int(n_modes), memory, TIME_COEFF * n_dofs * n_modes**2)
 
 
-def check_cost(cost: SolveCost, field: str, what: str) -> None:
+def check_cost(cost: SolveCost, field: str, what: str, advice: str) -> None:
     """InputError naming ``field`` when ``cost`` exceeds MEMORY_LIMIT or TIME_LIMIT.
 
-    what: the request in words, e.g. 'the band up to 72 kHz'."""
+    what: the request in words, e.g. 'the band up to 72000 Hz'; advice: what to do."""
     if cost.memory_bytes > MEMORY_LIMIT or cost.time_s > TIME_LIMIT:
         raise InputError(
             field,
-            f"{what} needs {cost.describe()} (estimated), above the limits "
-            f"{MEMORY_LIMIT / 1e9:.0f} GB / {TIME_LIMIT:.0f} s; lower {field}",
+            f"{what}: {cost.describe()} (estimated), above the limits "
+            f"{MEMORY_LIMIT / 1e9:.0f} GB / {TIME_LIMIT:.0f} s; {advice}",
         )

@@ -122,9 +122,9 @@ def _solve_cost(plate, boundary, res, mesh, fmax_hz, count, degree) -> SolveCost
         n_modes = min(n_modes, count)
     cost = solve_cost(mesh_dofs(mesh, res.theory, degree), n_modes)
     if fmax_hz is not None:
-        check_cost(cost, "fmax_hz", f"the band up to {fmax_hz:.0f} Hz")
+        check_cost(cost, "fmax_hz", f"the band up to {fmax_hz:.0f} Hz", "ask for a lower band")
     else:
-        check_cost(cost, "count", f"the first {count} modes")
+        check_cost(cost, "count", f"the first {count} modes", "ask for fewer modes")
     return cost
 
 
