@@ -10,7 +10,6 @@ input, as every command).
 """
 
 from tailbeam import claims as claims_mod
-from tailbeam.figures import scenario_figures
 from tailbeam.output import atomic_output_dir
 from tailbeam.results_io import (
     result_summary,
@@ -58,6 +57,8 @@ def clamp_summary(results, results_off, claims_off) -> str:
 
 
 def run(args) -> int:
+    from tailbeam.figures import scenario_figures  # matplotlib: not on every CLI start
+
     results = run_all()
     claims = claims_mod.evaluate(results)
     results_off = run_all(ContactSettings(clamp=False))

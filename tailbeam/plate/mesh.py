@@ -7,7 +7,6 @@ the plate is centred on the origin (tailbeam.bodies). Coordinates in m.
 
 from pathlib import Path
 
-import meshio
 import numpy as np
 from skfem import MeshTri
 
@@ -110,6 +109,8 @@ def save_mesh(mesh: MeshTri, path) -> Path:
     cells = [("line", np.vstack(lines))] if lines else []
     cells.append(("triangle", mesh.t.T))
     phys = ([np.concatenate(tags)] if lines else []) + [tri_tags]
+    import meshio  # only for files: 0.3-0.5 s of import the default path does not need
+
     out = meshio.Mesh(
         np.column_stack([mesh.p.T, np.zeros(mesh.p.shape[1])]),
         cells,
@@ -123,6 +124,7 @@ def save_mesh(mesh: MeshTri, path) -> Path:
 def load_mesh(path, plate: Plate, field: str = "mesh") -> MeshTri:
     """Read a triangular mesh with named boundary edges (any format meshio reads; Gmsh
     physical names or meshio cell sets) and check it against the plate."""
+    import meshio
     from skfem.io.meshio import from_meshio
 
     path = Path(path)
@@ -151,9 +153,7 @@ def default_mesh_path(plate: Plate, divisions) -> Path:
 
 
 def default_mesh(plate: Plate, divisions) -> MeshTri:
-    """The structured mesh with these divisions: read from meshes/ when the shipped file
-    exists, else generated (identical by construction; tests check this)."""
-    path = default_mesh_path(plate, divisions)
-    if path.is_file():
-        return load_mesh(path, plate)
+    """The structured mesh with these divisions, generated (milliseconds); the shipped
+    meshes/ files are identical copies for users (tests check this), not read here: reading
+    them would cost the meshio import on every cached run."""
     return structured_mesh(plate, divisions)
