@@ -9,6 +9,7 @@ from tailbeam.cli import main
 from tailbeam.contact_law import ball_plate_law
 from tailbeam.coupled import auto, simulate_coupled
 from tailbeam.errors import InputError
+from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.plate.closed_forms import ssss_static_compliance
@@ -50,6 +51,18 @@ def test_residual_compliance_estimate_matches_ssss_closed_form(f_cut):
     truth = full - np.sum(basis.deflection(pts) ** 2 / basis.omega**2, axis=1)
     ratio = truth / auto.residual_compliance_estimate(PLATE, f_cut)
     np.testing.assert_allclose(ratio, 1.0, atol=0.1)
+
+
+def test_undamped_pulse_matches_hertz_closed_forms():
+    # Truth: Johnson's closed forms (tailbeam.hertz) for an undamped impact on a rigid flat.
+    law = ball_plate_law(SANDSTONE, 0.02, CARBON_STEEL)
+    mass = Ball("b", SANDSTONE, 0.02, (0.0, 0.0, 0.03)).mass
+    pulse = auto.impact_pulse(mass, 2.0, law)
+    delta = hertz_max_penetration(mass, 2.0, law.stiffness, law.exponent)
+    assert pulse["duration_s"] == pytest.approx(hertz_contact_duration(mass, 2.0, law.stiffness))
+    assert pulse["compliance_m_n"] == pytest.approx(
+        delta / hertz_peak_force(mass, 2.0, law.stiffness), rel=1e-4
+    )
 
 
 @pytest.mark.parametrize(

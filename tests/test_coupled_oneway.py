@@ -7,6 +7,7 @@ import pytest
 from tailbeam.bodies import Ball, Plate
 from tailbeam.contact_law import ball_plate_law
 from tailbeam.coupled import choose_band, simulate_coupled, simulate_scene_modal
+from tailbeam.coupled.auto import BAND_ACCURACY
 from tailbeam.coupled.zener import point_impedance, zener_impact
 from tailbeam.hertz import hertz_contact_duration
 from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
@@ -72,9 +73,11 @@ def test_band_choice_from_contact_duration_and_sensors():
     law = contact.law_for(ball, CARBON_STEEL)
     speed = np.sqrt(1.0 + 2 * 9.80665 * 0.05)
     t_c = hertz_contact_duration(ball.mass, speed, law.stiffness)
-    assert band["contact_duration_min_s"] == pytest.approx(t_c)
-    assert band["fmax_hz"] == pytest.approx(6.0 / t_c)
-    assert band["truncation_force_level"] < 0.01
+    # the damped pulse (default contact damping) lasts a little longer than Hertz's
+    assert t_c <= band["contact_duration_min_s"] < 1.1 * t_c
+    # the band: the contacts' accuracy-driven need (tests/test_band.py checks its estimate)
+    assert band["fmax_hz"] == band["fmax_contact_hz"] >= 1.0 / band["contact_duration_min_s"]
+    assert band["truncation_force_error"] <= BAND_ACCURACY * (1 + 1e-6)
     fast = SensorSpec("s", (0.1, 0.1), sample_rate=102400.0)
     with_sensor = Scene((ball,), Plate(), contact, 0.1, plate_model="modal", sensors=(fast,))
     assert choose_band(with_sensor)["fmax_hz"] == pytest.approx(102400.0 / 2.56)
