@@ -5,7 +5,7 @@ Reading scene files lives in ``tailbeam.scene_file``; this module holds no I/O.
 
 from dataclasses import dataclass, field
 
-from tailbeam.bodies import Ball, Plate
+from tailbeam.bodies import STANDARD_GRAVITY, Ball, Plate
 from tailbeam.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
 from tailbeam.errors import (
     InputError,
@@ -146,7 +146,8 @@ class SensorSpec:
 
 @dataclass(frozen=True)
 class Scene:
-    """Everything that defines one simulation. duration in s, sample_rate (output) in Hz."""
+    """Everything that defines one simulation. duration in s, sample_rate (output) in Hz,
+    gravity in m/s^2 (along -z; 0 for none)."""
 
     balls: tuple[Ball, ...]
     plate: Plate = field(default_factory=Plate)
@@ -156,10 +157,12 @@ class Scene:
     plate_model: str = "rigid"
     modal: ModalPlateSettings | None = None
     sensors: tuple[SensorSpec, ...] = ()
+    gravity: float = STANDARD_GRAVITY
 
     def __post_init__(self):
         require_positive("duration", self.duration)
         require_positive("sample_rate", self.sample_rate)
+        object.__setattr__(self, "gravity", require_nonnegative("gravity", self.gravity))
         if self.plate_model not in PLATE_MODELS:
             raise InputError(
                 "plate.model", f"must be one of {PLATE_MODELS}, got {self.plate_model!r}"
