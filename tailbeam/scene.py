@@ -15,7 +15,7 @@ from tailbeam.errors import (
 )
 from tailbeam.materials import Material
 
-# Defaults where the paper is silent (README, "Defaults"). d = 0.1 mm is Adams' default penetration
+# Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams' default penetration
 # depth. c = 300 N s/m was chosen by running the paper's three scenarios over a grid of (c, d,
 # drop gap) and keeping every qualitative claim of sections 4.1-4.3 and conclusions 1-3 true
 # (tailbeam.claims, benchmarks/claim_map.py): with d = 0.1 mm all claims hold on the grid for

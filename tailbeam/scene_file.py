@@ -1,6 +1,6 @@
 """Scene files (TOML): read, validate and write back.
 
-The keys are a contract with users (README, "Scene files"): they may be extended, never renamed.
+The keys are a contract with users (docs/scene-files.md): they may be extended, never renamed.
 Every problem becomes ``InputError(field, rule)`` naming the offending key (``balls[2].radius``,
 balls counted from 1) and the rule; misspelled keys get the closest valid key as a suggestion.
 Omitted optional keys take the defaults of ``tailbeam.scene``.

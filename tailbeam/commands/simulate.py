@@ -24,7 +24,7 @@ from tailbeam.scene_file import load_scene, scene_to_dict
 
 
 def add_arguments(parser):
-    parser.add_argument("scene", help="scene file (TOML); keys in README, 'Scene files'")
+    parser.add_argument("scene", help="scene file (TOML); keys in docs/scene-files.md")
     parser.add_argument("--out", default="out/simulate", help="output directory")
 
 
