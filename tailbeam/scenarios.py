@@ -28,7 +28,8 @@ DROP_GAP = 0.005
 
 # Simulated time, s, per scenario. 4.1 and 4.2: 1 s shows 4-9 collisions per ball (the claims
 # compare the balls collision by collision); over 5-20 s the near-rest hops and the balls coming
-# to rest overturn the "collides more often" and "short contact" claims (docs/reproduction.md, "Defaults").
+# to rest overturn the "collides more often" and "short contact" claims
+# (docs/reproduction.md, "Defaults").
 # 4.3: 10 s, because the claim "coal comes to rest first" needs coal declared at rest
 # (tailbeam.rigid's definition: a rebound slower than its rest_speed, 0.01 m/s); with the STEP
 # ramp the damping vanishes at small penetration, so the last bounces are nearly elastic and

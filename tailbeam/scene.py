@@ -15,15 +15,15 @@ from tailbeam.errors import (
 )
 from tailbeam.materials import Material
 
-# Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams' default penetration
-# depth. c = 300 N s/m was chosen by running the paper's three scenarios over a grid of (c, d,
-# drop gap) and keeping every qualitative claim of sections 4.1-4.3 and conclusions 1-3 true
-# (tailbeam.claims, benchmarks/claim_map.py): with d = 0.1 mm all claims hold on the grid for
-# c = 300-350 N s/m at every drop gap 0-10 mm, and c = 300 is the one grid value that also holds at
-# 20 mm. The binding claim is 4.3 (coal rebounds above sandstone after collisions 1-2 and below
-# from the 3rd), which needs e_sand / e_coal of about 1.1. At ~1 m/s c = 300 gives restitution
-# 0.84 (coal) and 0.92 (sandstone) on steel; Adams' own default, c = 10 N s/mm, makes coal nearly
-# plastic (e ~ 0.1) and breaks 4.3 and 4.1.
+# Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams'
+# default penetration depth. c = 300 N s/m was chosen by running the paper's three scenarios over
+# a grid of (c, d, drop gap) and keeping every qualitative claim of sections 4.1-4.3 and
+# conclusions 1-3 true (tailbeam.claims, benchmarks/claim_map.py): with d = 0.1 mm all claims hold
+# on the grid for c = 300-350 N s/m at every drop gap 0-10 mm, and c = 300 is the one grid value
+# that also holds at 20 mm. The binding claim is 4.3 (coal rebounds above sandstone after
+# collisions 1-2 and below from the 3rd), which needs e_sand / e_coal of about 1.1. At ~1 m/s c =
+# 300 gives restitution 0.84 (coal) and 0.92 (sandstone) on steel; Adams' own default, c = 10 N
+# s/mm, makes coal nearly plastic (e ~ 0.1) and breaks 4.3 and 4.1.
 DEFAULT_DAMPING = 300.0  # c, N s/m
 DEFAULT_PENETRATION = 1e-4  # d, m (Adams' default 0.1 mm)
 

@@ -20,7 +20,7 @@ from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration
 from tailbeam.modal import ModalBasis
 
-DEFAULT_DAMPING_RATIO = 0.01  # of every mode; docs/coupled-and-sensors.md (welded steel, light joints)
+DEFAULT_DAMPING_RATIO = 0.01  # of every mode; README "Defaults" (welded steel, light joints)
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid solver's value, so both models stop alike
 DEFAULT_STEPS_PER_CONTACT = 200  # steps per Hertz contact duration: ~1e-5 relative error
 _EVENT_NAMES = {
