@@ -35,3 +35,14 @@ def configure_numba_cache() -> Path:
     else:
         os.environ["NUMBA_CACHE_DIR"] = str(folder)
     return folder
+
+
+def announce_first_compile(solver: str = "rigid") -> None:
+    """Say so (tailbeam.progress.note) when numba's cache holds no compiled kernel of
+    ``solver`` (``"rigid"`` or ``"coupled"``, numba names its cache folders after the source
+    folder): the first run compiles them (10-20 s), later runs load them from the cache."""
+    folder = Path(os.environ.get("NUMBA_CACHE_DIR") or cache_root() / "numba")
+    if not any(folder.glob(f"{solver}*/*.nbi")):
+        from tailbeam.progress import note
+
+        note(f"first run: compiling the contact kernels with numba (10-20 s, cached in {folder})")

@@ -23,7 +23,6 @@ from tailbeam.errors import (
 from tailbeam.materials import BUILTIN_MATERIALS, Material, get_material
 from tailbeam.preflight import check_scene
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene, SensorSpec
-from tailbeam.sensor import resolve
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -289,6 +288,8 @@ def _first_approach(dx, dy, ux, uy, reach, duration):
 
 
 def _parse_sensors(value, plate: Plate) -> tuple:
+    from tailbeam.sensor import resolve  # scipy.signal: imported only for scenes with sensors
+
     sensors = []
     for i, t in enumerate(_array_of_tables("sensors", value), start=1):
         field = f"sensors[{i}]"

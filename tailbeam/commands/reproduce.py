@@ -9,20 +9,11 @@ Exit code 0 when every claim holds (with the clamp, the default), 1 if any fails
 input, as every command).
 """
 
-from tailbeam import claims as claims_mod
-from tailbeam.figures import scenario_figures
+from tailbeam.cachedir import announce_first_compile
 from tailbeam.output import atomic_output_dir, check_output_dir
 from tailbeam.progress import task
-from tailbeam.results_io import (
-    result_summary,
-    write_claims,
-    write_impacts_csv,
-    write_json,
-    write_timeseries_csv,
-)
-from tailbeam.scenarios import SCENARIOS, run_all
-from tailbeam.scene import ContactSettings
-from tailbeam.scene_file import scene_to_dict
+
+# The solver, figures and claims are imported in run(), so `tailbeam --help` stays fast.
 
 
 def add_arguments(parser):
@@ -59,7 +50,13 @@ def clamp_summary(results, results_off, claims_off) -> str:
 
 
 def run(args) -> int:
+    from tailbeam import claims as claims_mod
+    from tailbeam.results_io import write_claims
+    from tailbeam.scenarios import run_all
+    from tailbeam.scene import ContactSettings
+
     check_output_dir(args.out)
+    announce_first_compile()
     with task("simulating the paper's scenarios (with and without the clamp)", total=2) as bar:
         results = run_all()
         bar.update(1)
@@ -68,18 +65,33 @@ def run(args) -> int:
     claims = claims_mod.evaluate(results)
     claims_off = claims_mod.evaluate(results_off)
     with atomic_output_dir(args.out, command="tailbeam reproduce") as tmp:
-        for key, result in results.items():
-            scenario = SCENARIOS[key]
-            sub = tmp / key
-            sub.mkdir()
-            write_impacts_csv(sub / "impacts.csv", result.impacts)
-            echo = scene_to_dict(scenario.scene())
-            write_json(sub / "impacts.json", result_summary(result, echo))
-            write_timeseries_csv(sub / "timeseries.csv", result, echo["sample_rate"])
-            scenario_figures(result, scenario, tmp, sample_rate=echo["sample_rate"])
+        _write_scenarios(tmp, results)
         write_claims(tmp, claims)
         write_claims(tmp, claims_off, stem="claims_clamp_off")
     print(format_table(claims))
     print(clamp_summary(results, results_off, claims_off))
     print(f"results, figures and claims.csv/claims.md written to {args.out}")
     return 0 if all(c.passed for c in claims) else 1
+
+
+def _write_scenarios(tmp, results) -> None:
+    """Per scenario: impacts.csv, impacts.json, timeseries.csv and the figures."""
+    from tailbeam.figures import scenario_figures
+    from tailbeam.results_io import (
+        result_summary,
+        write_impacts_csv,
+        write_json,
+        write_timeseries_csv,
+    )
+    from tailbeam.scenarios import SCENARIOS
+    from tailbeam.scene_file import scene_to_dict
+
+    for key, result in results.items():
+        scenario = SCENARIOS[key]
+        sub = tmp / key
+        sub.mkdir()
+        write_impacts_csv(sub / "impacts.csv", result.impacts)
+        echo = scene_to_dict(scenario.scene())
+        write_json(sub / "impacts.json", result_summary(result, echo))
+        write_timeseries_csv(sub / "timeseries.csv", result, echo["sample_rate"])
+        scenario_figures(result, scenario, tmp, sample_rate=echo["sample_rate"])

@@ -9,18 +9,12 @@ results replace DIR whole (tailbeam.output), so DIR never mixes two runs.
 
 import math
 
-from tailbeam.figures import sensor_figure
+from tailbeam.cachedir import announce_first_compile
 from tailbeam.output import atomic_output_dir, check_output_dir, describe
 from tailbeam.progress import note, task
-from tailbeam.results_io import (
-    result_summary,
-    write_impacts_csv,
-    write_json,
-    write_sensor_spectra_csv,
-    write_sensors_csv,
-    write_timeseries_csv,
-)
-from tailbeam.scene_file import load_scene, scene_to_dict
+
+# Heavy modules (scipy.signal, matplotlib) are imported where they are used, so that
+# `tailbeam --help` and bad-input errors answer in a fraction of a second.
 
 
 def add_arguments(parser):
@@ -65,6 +59,14 @@ def _describe_choices(choices: dict) -> str:
 
 def write_results(out_dir, scene, result) -> list:
     """Write every output file of ``result`` into ``out_dir`` (an existing directory)."""
+    from tailbeam.results_io import (
+        result_summary,
+        write_impacts_csv,
+        write_json,
+        write_timeseries_csv,
+    )
+    from tailbeam.scene_file import scene_to_dict
+
     summary = result_summary(result, scene_to_dict(scene))
     summary["automatic_choices"] = _choices(result)
     files = [
@@ -80,6 +82,9 @@ def write_results(out_dir, scene, result) -> list:
 
 
 def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
+    from tailbeam.figures import sensor_figure
+    from tailbeam.results_io import write_sensor_spectra_csv, write_sensors_csv
+
     meta = {
         s.name: {
             "position_m": list(s.position),
@@ -107,8 +112,11 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
 
 
 def run(args) -> int:
+    from tailbeam.scene_file import load_scene
+
     check_output_dir(args.out)
     scene = load_scene(args.scene)
+    announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
     result = solve(scene)
     line = _describe_choices(_choices(result))
     if line:
