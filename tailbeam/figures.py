@@ -132,15 +132,24 @@ def force_figure(result, scenario, t, states, number) -> Figure:
 
 
 def time_figure(result, scenario, t, states, key, label, number) -> Figure:
-    """One quantity of every ball against time on one axes."""
+    """One quantity of every ball against time on one axes (the ball with the larger impacts
+    drawn first); a note names the per-collision figure when the collisions are too many to
+    tell apart."""
     fig = Figure(figsize=(7.0, 3.6), layout="constrained")
     ax = fig.add_subplot()
-    for i, name in enumerate(b.name for b in result.balls):
+    for i, name in _ball_order(result):
         ax.plot(t, states[name][key], lw=0.8, color=_colour(i), label=name)
     ax.set_xlabel("time t (s)")
     ax.set_ylabel(label)
-    ax.set_title(_title(scenario, number), fontsize=9)
-    ax.legend(loc="upper right")
+    title = _title(scenario, number)
+    if max(len(result.impacts_of(b.name)) for b in result.balls) > MAX_MARKED_IMPACTS:
+        title += (
+            f"\nper collision: collisions_{scenario.key}.png; one pulse: pulse_{scenario.key}.png"
+        )
+    ax.set_title(title, fontsize=9)
+    handles, names = ax.get_legend_handles_labels()
+    order = np.argsort([[b.name for b in result.balls].index(n) for n in names])
+    ax.legend([handles[k] for k in order], [names[k] for k in order], loc="upper right")
     ax.grid(alpha=0.3)
     return fig
 
@@ -207,23 +216,26 @@ def pulse_figure(result, scenario) -> Figure:
     and force against penetration (the loop's area is the energy the contact dissipates)."""
     fig = Figure(figsize=(10.0, 3.8), layout="constrained")
     ax_t, ax_d = fig.subplots(1, 2)
+    pulses = first_pulses(result)
     for i, name in enumerate(b.name for b in result.balls):
-        if name not in (pulses := first_pulses(result)):
+        if name not in pulses:
             continue
         tau, delta, force = pulses[name]
         imp = result.impacts_of(name)[0]
         label = f"{name}: {imp.peak_force:.0f} N peak, {tau[-1] * 1e6:.0f} µs"
+        marker = MARKERS[i % len(MARKERS)]
         ax_t.plot(tau * 1e6, force, color=_colour(i), lw=1.2, label=label)
-        ax_t.plot((imp.t_peak - imp.t_start) * 1e6, imp.peak_force, MARKERS[i], color=_colour(i))
+        ax_t.plot((imp.t_peak - imp.t_start) * 1e6, imp.peak_force, marker, color=_colour(i))
         ax_d.plot(delta * 1e6, force, color=_colour(i), lw=1.2, label=name)
     ax_t.set_xlabel("time since contact start (µs)")
     ax_t.set_ylabel("contact force (N)")
-    ax_t.set_title("first contact of each ball; marker: peak in impacts.csv", fontsize=9)
+    ax_t.set_title("first contact of each ball\n(marker: peak force in impacts.csv)", fontsize=9)
     ax_t.legend(fontsize=8)
+    ax_d.legend(fontsize=8, loc="upper left")
     ax_d.set_xlabel("penetration δ (µm)")
     ax_d.set_ylabel("contact force (N)")
     ax_d.set_title(
-        "force against penetration (upper branch: loading); loop area = energy lost", fontsize=9
+        "force against penetration\n(upper branch: loading; loop area = energy lost)", fontsize=9
     )
     for a in (ax_t, ax_d):
         a.grid(alpha=0.3)

@@ -177,3 +177,22 @@ def test_sensor_figure_states_position_resolution_peak_rms():
     buf = io.BytesIO()
     fig.savefig(buf, format="png")
     assert buf.getvalue()[:4] == b"\x89PNG"
+
+
+def test_scenario_figures_have_nothing_cut_off(material):
+    t = figures.plot_grid(material, 20000.0)
+    states = material.sample(t)
+    scenario = SCENARIOS["material"]
+    built = [
+        figures.force_figure(material, scenario, t, states, 7),
+        figures.time_figure(material, scenario, t, states, "z", "z (m)", 5),
+        figures.collision_figure(material, scenario),
+        figures.pulse_figure(material, scenario),
+        build_sensor_figure(sine_output(), position=(0.2, -0.1)),
+    ]
+    for fig in built:
+        renderer = render(fig)
+        drawn = fig.get_tightbbox(renderer)  # inches, every artist as drawn
+        page = fig.bbox_inches
+        assert drawn.x0 >= page.x0 and drawn.x1 <= page.x1, fig.texts
+        assert drawn.y0 >= page.y0 and drawn.y1 <= page.y1, fig.texts
