@@ -10,6 +10,7 @@ import io
 import numpy as np
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.text import Text
 
 from benchmarks.claim_map import QUICK
 from tailbeam import figures
@@ -38,7 +39,7 @@ def inside(fig, artist, renderer) -> bool:
 
 def texts(fig) -> str:
     render(fig)
-    return "\n".join(t.get_text() for t in fig.findobj(lambda a: hasattr(a, "get_text")))
+    return "\n".join(t.get_text() for t in fig.findobj(Text))
 
 
 @pytest.fixture(scope="module")
@@ -82,6 +83,9 @@ def test_claim_map_axes_positive_and_label_not_cut():
     assert inside(fig, colorbar.ax.yaxis.label, renderer)
     assert all(inside(fig, leg, renderer) for leg in fig.legends)
     assert colorbar.get_ticks()[-1] == 19
+    drawn = fig.get_tightbbox(renderer)
+    assert fig.bbox_inches.x0 <= drawn.x0 and drawn.x1 <= fig.bbox_inches.x1
+    assert fig.bbox_inches.y0 <= drawn.y0 and drawn.y1 <= fig.bbox_inches.y1
 
 
 def test_log_edges_geometric():

@@ -3,11 +3,13 @@ the closed-form SSSS frequency order, and modes.png."""
 
 import numpy as np
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.text import Text
 
 from tailbeam.bodies import Plate
 from tailbeam.plate import compute_modes
 from tailbeam.plate.closed_forms import ssss_modes
-from tailbeam.plate.export import write_png
+from tailbeam.plate.export import build_modes_figure, write_png
 from tailbeam.plate.mode_labels import label_modes, nodal_label, projection_label
 
 A, B = 0.6, 0.4
@@ -70,3 +72,12 @@ def test_cantilever_first_bending_then_torsion(tmp_path):
     assert [(lab.m, lab.n) for lab in labels] == [(1, 1), (1, 2)]
     path = write_png(tmp_path / "modes.png", basis)
     assert path.read_bytes()[:4] == b"\x89PNG"
+    fig = build_modes_figure(basis)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    drawn, page = fig.get_tightbbox(canvas.get_renderer()), fig.bbox_inches
+    assert page.x0 <= drawn.x0 and drawn.x1 <= page.x1 and page.y0 <= drawn.y0
+    assert drawn.y1 <= page.y1
+    words = "\n".join(t.get_text() for t in fig.findobj(Text))
+    assert "left clamped, bottom free, right free, top free" in words
+    assert "nodal (1, 2)" in words

@@ -4,6 +4,7 @@ I/O only; the physics lives in the other modules.
 """
 
 import csv
+import textwrap
 from pathlib import Path
 
 import meshio
@@ -88,6 +89,12 @@ def _draw_edges(ax, boundary: str, a: float, b: float) -> None:
 
 
 def write_png(path, basis: ModalBasis, n_modes: int = PNG_MODES) -> Path:
+    """Write build_modes_figure(basis, n_modes) to ``path`` (PNG); returns the path."""
+    build_modes_figure(basis, n_modes).savefig(path, dpi=110)
+    return Path(path)
+
+
+def build_modes_figure(basis: ModalBasis, n_modes: int = PNG_MODES) -> Figure:
     """A grid of the first modes' deflection (colour, nodal lines in black) with frequency and
     (m, n) label in the titles (tailbeam.plate.mode_labels) and the edge conditions drawn on
     every panel (solid: clamped, dashed: simply supported, dotted: free)."""
@@ -102,7 +109,8 @@ def write_png(path, basis: ModalBasis, n_modes: int = PNG_MODES) -> Path:
     labels = label_modes(basis.boundary, shapes, x, y, a, b)
     cols = min(4, n)
     rows = int(np.ceil(n / cols))
-    fig = Figure(figsize=(3.0 * cols, 3.0 * rows + 1.0), layout="constrained")
+    width = max(3.0 * cols, 6.0)
+    fig = Figure(figsize=(width, 3.0 * rows + 1.2), layout="constrained")
     axes = fig.subplots(rows, cols, squeeze=False)
     for i, ax in enumerate(axes.ravel()):
         ax.set_axis_off()
@@ -120,13 +128,14 @@ def write_png(path, basis: ModalBasis, n_modes: int = PNG_MODES) -> Path:
         ax.set_title(
             f"mode {i + 1}: {basis.frequencies_hz[i]:.1f} Hz\n{labels[i].text()}", fontsize=8
         )
-    fig.suptitle(_heading(basis), fontsize=9)
+    fig.suptitle(_heading(basis, width), fontsize=9)
     fig.legend(handles=_legend_handles(), loc="outside lower center", ncols=4, fontsize=8)
-    fig.savefig(path, dpi=110)
-    return Path(path)
+    return fig
 
 
-def _heading(basis: ModalBasis) -> str:
+def _heading(basis: ModalBasis, width_in: float) -> str:
+    """Title lines: plate, theory, edge conditions, how to read a panel; wrapped to fit a
+    figure ``width_in`` inches wide (at 9 pt, about 14 characters per inch)."""
     edges = ", ".join(
         f"{edge} {CONDITIONS[c]}" for edge, c in zip(EDGES, basis.boundary, strict=True)
     )
@@ -137,11 +146,14 @@ def _heading(basis: ModalBasis) -> str:
         else "nodal (m, n): 1 + nodal lines crossed along x, along y (a half-wave count, "
         "not a closed-form index)"
     )
-    return (
+    lines = [
         f"{basis.boundary} plate {plate.size_x:g} x {plate.size_y:g} x {plate.thickness:g} m, "
-        f"{basis.theory} ({basis.info.get('element', '')})\nedges: {edges}\n"
-        f"x to the right, y up; colour: deflection (red +, blue -), black: nodal lines; {meaning}"
-    )
+        f"{basis.theory} ({basis.info.get('element', '')})",
+        f"edges: {edges}",
+        "x to the right, y up; colour: deflection (red +, blue -), black: nodal lines",
+        meaning,
+    ]
+    return "\n".join(textwrap.fill(line, int(14 * width_in)) for line in lines)
 
 
 def _legend_handles() -> list:
