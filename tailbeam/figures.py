@@ -149,7 +149,12 @@ def time_figure(result, scenario, t, states, key, label, number) -> Figure:
     ax.set_title(title, fontsize=9)
     handles, names = ax.get_legend_handles_labels()
     order = np.argsort([[b.name for b in result.balls].index(n) for n in names])
-    ax.legend([handles[k] for k in order], [names[k] for k in order], loc="upper right")
+    ax.legend(  # outside the axes: the curves fill the whole record
+        [handles[k] for k in order],
+        [names[k] for k in order],
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),
+    )
     ax.grid(alpha=0.3)
     return fig
 
