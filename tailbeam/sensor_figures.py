@@ -74,25 +74,27 @@ def welch_psd(output, segment: int):
     )
 
 
+def time_unit(duration: float) -> tuple:
+    """(scale, name) for time axes: ms for records shorter than 2 s, else s."""
+    return (1e3, "ms") if duration < 2.0 else (1.0, "s")
+
+
 def _time_panel(ax, output, stats):
-    t_ms = output.t * 1e3
-    ax.plot(t_ms, output.acceleration, lw=0.6, color="C0")
-    ax.axhline(stats.rms, color="C3", lw=0.8, ls="--", label=f"±RMS = {stats.rms:.3g} m/s$^2$")
-    ax.axhline(-stats.rms, color="C3", lw=0.8, ls="--")
-    ax.plot(
-        stats.t_peak * 1e3,
-        stats.peak_value,
-        "v" if stats.peak_value > 0 else "^",
-        color="C1",
-        label=f"peak |a| = {stats.peak:.3g} m/s$^2$ at {stats.t_peak * 1e3:.2f} ms",
-    )
-    ax.set_xlabel("time t (ms)")
+    scale, unit = time_unit(stats.duration)
+    ax.plot(output.t * scale, output.acceleration, lw=0.6, color="C0")
+    for level in (stats.rms, -stats.rms):
+        ax.axhline(level, color="C3", lw=0.8, ls="--")
+    marker = "v" if stats.peak_value > 0 else "^"
+    ax.plot(stats.t_peak * scale, stats.peak_value, marker, color="C1", ms=7)
+    ax.set_xlabel(f"time t ({unit})")
     ax.set_ylabel("acceleration (m/s$^2$)")
     ax.set_title(
-        f"record: {stats.n_samples} samples over {stats.duration * 1e3:.4g} ms; RMS over all",
+        f"record: {stats.n_samples} samples over {stats.duration * scale:.4g} {unit}; "
+        f"RMS = {stats.rms:.3g} m/s$^2$ (dashed: ±RMS)\n"
+        f"peak |a| = {stats.peak:.3g} m/s$^2$ at t = {stats.t_peak * scale:.4g} {unit} "
+        f"(orange marker)",
         fontsize=9,
     )
-    ax.legend(fontsize=7, loc="upper right")
 
 
 def _spectrum_panel(ax, output, stats, f_max):
@@ -133,13 +135,14 @@ def _spectrogram_panel(fig, ax, output, stats, f_max):
     keep = f <= f_max
     db = 10.0 * np.log10(np.maximum(s[keep], 1e-300))
     top = db.max()
+    scale, unit = time_unit(stats.duration)
     mesh = ax.pcolormesh(
-        t * 1e3, f[keep] / 1e3, db, shading="nearest", cmap="magma", vmin=top - DB_RANGE, vmax=top
+        t * scale, f[keep] / 1e3, db, shading="nearest", cmap="magma", vmin=top - DB_RANGE, vmax=top
     )
     fig.colorbar(mesh, ax=ax, label="PSD (dB re 1 (m/s$^2$)$^2$/Hz)")
-    ax.set_xlim(0.0, stats.duration * 1e3)
+    ax.set_xlim(0.0, stats.duration * scale)
     ax.set_ylim(0.0, f_max / 1e3)
-    ax.set_xlabel("time t (ms)")
+    ax.set_xlabel(f"time t ({unit})")
     ax.set_ylabel("frequency (kHz)")
     ax.set_title(
         f"spectrogram: Hann segments of {seg} samples ({seg / fs * 1e3:.3g} ms), "
