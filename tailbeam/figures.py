@@ -27,7 +27,7 @@ MARKERS = ("o", "^", "s", "D")
 MAX_MARKED_IMPACTS = 40  # per ball: mark each peak in the force figure up to this many
 ZOOM_SAMPLES = 1500  # samples in the zoom on the first contacts
 DPI = 120
-ALL_HOLD = {"marker": "*", "ls": "none", "ms": 7, "mfc": "white", "mec": "black", "mew": 0.5}
+ALL_HOLD = {"marker": "*", "ls": "none", "ms": 5, "mfc": "white", "mec": "black", "mew": 0.5}
 
 
 def _colour(i: int) -> str:
