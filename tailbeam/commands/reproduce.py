@@ -14,7 +14,8 @@ input, as every command).
 
 from tailbeam import claims as claims_mod
 from tailbeam.figures import scenario_figures
-from tailbeam.output import atomic_output_dir
+from tailbeam.output import atomic_output_dir, check_output_dir
+from tailbeam.progress import task
 from tailbeam.results_io import (
     result_summary,
     write_claims,
@@ -61,11 +62,15 @@ def clamp_summary(results, results_off, claims_off) -> str:
 
 
 def run(args) -> int:
-    results = run_all()
+    check_output_dir(args.out)
+    with task("simulating the paper's scenarios (with and without the clamp)", total=2) as bar:
+        results = run_all()
+        bar.update(1)
+        results_off = run_all(ContactSettings(clamp=False))
+        bar.update(1)
     claims = claims_mod.evaluate(results)
-    results_off = run_all(ContactSettings(clamp=False))
     claims_off = claims_mod.evaluate(results_off)
-    with atomic_output_dir(args.out) as tmp:
+    with atomic_output_dir(args.out, command="tailbeam reproduce") as tmp:
         for key, result in results.items():
             scenario = SCENARIOS[key]
             sub = tmp / key
