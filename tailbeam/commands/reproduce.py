@@ -2,9 +2,12 @@
 
 Runs the three built-in scenarios with the default contact settings, writes per scenario
 <key>/impacts.csv, <key>/impacts.json and <key>/timeseries.csv, the figures fig02-fig10 (the
-analogues of the paper's Figs. 2-10) and claims.csv / claims.md, and prints every claim with
-PASS/FAIL and the numbers behind it. It also re-checks the claims without Adams' clamp (the
-paper's literal eq. 1) into claims_clamp_off.csv / .md and prints a one-line comparison.
+analogues of the paper's Figs. 2-10; the force figures add peak markers and a zoom on the first
+contacts), collisions_<key>.png (peak force, rebound height and restitution against collision
+number) and pulse_<key>.png (one pulse per ball; tailbeam.figures.scenario_figures), and
+claims.csv / claims.md, and prints every claim with PASS/FAIL and the numbers behind it. It
+also re-checks the claims without Adams' clamp (the paper's literal eq. 1) into
+claims_clamp_off.csv / .md and prints a one-line comparison.
 Exit code 0 when every claim holds (with the clamp, the default), 1 if any fails (2 for bad
 input, as every command).
 """
