@@ -106,7 +106,8 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
         ),
     ]
     for name, out in outputs.items():
-        files.append(sensor_figure(out, out_dir / f"sensor_{name}.png"))
+        position = tuple(meta[name]["position_m"])
+        files.append(sensor_figure(out, out_dir / f"sensor_{name}.png", position=position))
         bar.update(1)
     return files
 
