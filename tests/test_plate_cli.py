@@ -7,6 +7,7 @@ import numpy as np
 
 from tailbeam.bodies import Plate
 from tailbeam.cli import main
+from tailbeam.output import MANIFEST
 from tailbeam.plate.closed_forms import ssss_modes
 
 
@@ -37,7 +38,7 @@ def test_bad_boundary_code_is_one_line_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "out"
     code = main(["modes", "--bc", "SSQS", "--out", str(out)])
     err = capsys.readouterr().err
-    assert code == 2 and err.count("\n") == 1 and "--bc" in err
+    assert code == 2 and err.count("\n") == 1 and "--bc:" in err
     assert not out.exists()
 
 
@@ -48,7 +49,7 @@ def test_default_output_is_frequencies_only(tmp_path, monkeypatch, capsys):
         ["modes", "--count", "3", "--theory", "kirchhoff", "--divisions", "6", "--out", str(out)]
     )
     assert code == 0
-    assert sorted(p.name for p in out.iterdir()) == ["frequencies.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["frequencies.csv", MANIFEST]
 
 
 def test_too_large_band_names_the_option_before_work(tmp_path, capsys):

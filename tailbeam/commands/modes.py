@@ -12,16 +12,20 @@ costly to compute (tailbeam.plate.cost, estimated before anything is assembled).
 from tailbeam.bodies import Plate
 from tailbeam.errors import InputError
 from tailbeam.materials import get_material
-from tailbeam.output import atomic_output_dir
+from tailbeam.output import atomic_output_dir, check_output_dir
 
+# library field names -> the options a user typed (tailbeam.cli renames InputError fields)
 CLI_FIELDS = {
-    "fmax_hz": "--fmax",
-    "count": "--count",
-    "divisions": "--divisions",
-    "accuracy": "--accuracy",
-    "theory": "--theory",
-    "mesh": "--mesh",
     "boundary": "--bc",
+    "fmax": "--fmax",
+    "count": "--count",
+    "theory": "--theory",
+    "divisions": "--divisions",
+    "mesh": "--mesh",
+    "accuracy": "--accuracy",
+    "material": "--material",
+    "plate": "--size",
+    "fmax_hz": "--fmax",  # compute_modes' keyword (also its cost refusal)
 }
 
 
@@ -94,25 +98,23 @@ def reference_frequencies(basis):
 def run(args) -> int:
     from tailbeam.plate import compute_modes
 
+    check_output_dir(args.out)
     if args.count is not None and args.count < 1:
-        raise InputError("--count", f"must be >= 1, got {args.count}")
-    material = get_material(args.material, field="--material")
+        raise InputError("count", f"must be >= 1, got {args.count}")
+    material = get_material(args.material, field="material")
     a, b, h = args.size
     plate = Plate(material=material, size_x=a, size_y=b, thickness=h)
-    try:
-        basis = compute_modes(
-            plate,
-            args.bc,
-            theory=args.theory,
-            fmax_hz=args.fmax,
-            count=args.count,
-            mesh=args.mesh,
-            divisions=args.divisions,
-            accuracy=args.accuracy,
-            use_cache=not args.no_cache,
-        )
-    except InputError as err:
-        raise err.renamed(CLI_FIELDS) from None
+    basis = compute_modes(
+        plate,
+        args.bc,
+        theory=args.theory,
+        fmax_hz=args.fmax,
+        count=args.count,
+        mesh=args.mesh,
+        divisions=args.divisions,
+        accuracy=args.accuracy,
+        use_cache=not args.no_cache,
+    )
     refs = reference_frequencies(basis)
     info = basis.info
     print(
@@ -144,7 +146,7 @@ def _write(args, basis, refs) -> None:
 
     ref, ref_name = refs[0][1] if refs else None, refs[0][0] if refs else ""
     names = ["frequencies.csv"]
-    with atomic_output_dir(args.out) as tmp:
+    with atomic_output_dir(args.out, command="tailbeam modes") as tmp:
         export.write_frequencies_csv(
             tmp / "frequencies.csv", basis.frequencies_hz, basis.theory, ref, ref_name
         )

@@ -162,7 +162,7 @@ def choose_band(scene: Scene, settings: ModalPlateSettings | None = None) -> dic
     """The modal band for ``scene``: fmax (Hz) with the reasons and the estimated errors."""
     settings = settings or scene.modal or ModalPlateSettings()
     residual = settings.residual_flexibility
-    contacts = _contacts(scene)
+    contacts = _contacts(scene, scene.gravity)
     needs = {name: contact_band(scene.plate, c, residual=residual) for name, c in contacts.items()}
     hardest = max(needs, key=needs.get)
     f_contact = needs[hardest]
@@ -245,6 +245,7 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
         rayleigh=settings.rayleigh,
         residual_flexibility=settings.residual_flexibility,
         coupling=settings.coupling,
+        gravity=scene.gravity,
         **options,
     )
     result.info["band"] = band
