@@ -24,7 +24,8 @@ Band. Two outputs need modes: the sensor signals and the contact forces.
   the FE Mindlin plate of the 30-ball scene see benchmarks/bench_band.py and NOTES-band.md.
   The contacts need the smallest fc >= 1/T with force error <= ``BAND_ACCURACY``. Without
   residual flexibility the modes above fc are missing: error ~ BAND_SAFETY (e/2) C_res / C_c.
-fmax = max(sensor bandwidth, contact band). The user's [plate] fmax overrides.
+fmax = max(sensor bandwidth, contact band), rounded up to a multiple of BAND_GRID_HZ so that
+small edits of a scene reuse the cached basis. The user's [plate] fmax overrides.
 
 Assumption for the sensors (stated in result.info["band"]["sensor_note"]): with fmax at the
 bandwidth every mode a sensor can see is kept; the modes above fmax reach a sensor only
@@ -52,6 +53,7 @@ from tailbeam.sensor import resolve
 
 BAND_ACCURACY = 5e-3  # target peak-force error from the band: half the outputs' 1 %
 BAND_SAFETY = 20.0  # on the force-error estimate (calibrated, see the module docstring)
+BAND_GRID_HZ = 500.0  # the automatic fmax is rounded up to a multiple of this (cache reuse)
 PULSE_SAMPLES = 1000  # samples of the rigid-plate force pulse for its RMS frequency
 MIN_CONTACT_BAND_FACTOR = 1.0  # fc >= 1 / T: modes below 1/T respond dynamically
 SCENE_FIELDS = {"fmax_hz": "plate.fmax", "divisions": "plate.mesh_divisions"}
@@ -167,7 +169,8 @@ def choose_band(scene: Scene, settings: ModalPlateSettings | None = None) -> dic
     hardest = max(needs, key=needs.get)
     f_contact = needs[hardest]
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
-    chosen = max(f_contact, f_sensor)
+    # on a grid, so that small edits of a scene (a ball's height or speed) reuse the cached basis
+    chosen = BAND_GRID_HZ * math.ceil(max(f_contact, f_sensor) / BAND_GRID_HZ - 1e-9)
     fmax = settings.fmax_hz if settings.fmax_hz is not None else chosen
     errors = {
         name: force_error_estimate(scene.plate, fmax, c, residual=residual)
