@@ -172,6 +172,7 @@ def choose_band(scene: Scene, settings: ModalPlateSettings | None = None) -> dic
     # on a grid, so that small edits of a scene (a ball's height or speed) reuse the cached basis
     chosen = BAND_GRID_HZ * math.ceil(max(f_contact, f_sensor) / BAND_GRID_HZ - 1e-9)
     fmax = settings.fmax_hz if settings.fmax_hz is not None else chosen
+    t_min = min(c["duration_s"] for c in contacts.values())
     errors = {
         name: force_error_estimate(scene.plate, fmax, c, residual=residual)
         for name, c in contacts.items()
@@ -181,18 +182,26 @@ def choose_band(scene: Scene, settings: ModalPlateSettings | None = None) -> dic
         "user_fmax": settings.fmax_hz is not None,
         "reason": _reason(settings, f_contact, f_sensor, hardest),
         "accuracy": BAND_ACCURACY,
-        "contact_duration_min_s": min(c["duration_s"] for c in contacts.values()),
+        "contact_duration_min_s": t_min,
         "fmax_contact_hz": float(f_contact),
         "fmax_sensors_hz": float(f_sensor),
         "hardest_contact": hardest,
         # estimated relative peak-force error from the band, worst ball
         "truncation_force_error": float(max(errors.values())),
+        # kept from the earlier rule (a contract of impacts.json): the half-sine force-spectrum
+        # level 1/((2 fmax T_min)^2 - 1) of the shortest contact at fmax
+        "truncation_force_level": _spectrum_level(fmax, t_min),
         "sensor_band_covered": bool(fmax >= f_sensor),
         "sensor_note": (
             "modes above fmax reach the sensors only quasi-statically (not included until "
             "the mode-acceleration correction, issue 9)"
         ),
     }
+
+
+def _spectrum_level(fmax, t_min) -> float:
+    x = 2.0 * fmax * t_min
+    return float(1.0 / (x * x - 1.0)) if x > 1.0 else 1.0
 
 
 def _reason(settings, f_contact, f_sensor, hardest) -> str:
