@@ -12,7 +12,7 @@ costly to compute (tailbeam.plate.cost, estimated before anything is assembled).
 from tailbeam.bodies import Plate
 from tailbeam.errors import InputError
 from tailbeam.materials import get_material
-from tailbeam.output import atomic_output_dir, check_output_dir
+from tailbeam.output import atomic_output_dir, check_output_dir, describe
 
 # library field names -> the options a user typed (tailbeam.cli renames InputError fields)
 CLI_FIELDS = {
@@ -147,8 +147,15 @@ def _write(args, basis, refs) -> None:
     ref, ref_name = refs[0][1] if refs else None, refs[0][0] if refs else ""
     names = ["frequencies.csv"]
     with atomic_output_dir(args.out, command="tailbeam modes") as tmp:
-        export.write_frequencies_csv(
+        path = export.write_frequencies_csv(
             tmp / "frequencies.csv", basis.frequencies_hz, basis.theory, ref, ref_name
+        )
+        describe(
+            path,
+            units={"frequency_hz": "Hz", "reference_hz": "Hz", "rel_error": "1"},
+            boundary=basis.boundary,
+            theory=basis.theory,
+            plate_m=[basis.plate.size_x, basis.plate.size_y, basis.plate.thickness],
         )
         if args.vtu:
             export.write_vtu(tmp / "modes.vtu", basis)

@@ -7,8 +7,6 @@ nothing is written: the scene and --out are fully validated before the solver ru
 results replace DIR whole (tailbeam.output), so DIR never mixes two runs.
 """
 
-import math
-
 from tailbeam.cachedir import announce_first_compile
 from tailbeam.output import atomic_output_dir, check_output_dir, describe
 from tailbeam.progress import note, task
@@ -42,19 +40,6 @@ def _choices(result) -> dict:
     """What was chosen automatically (band, basis), as recorded by the solver."""
     info = getattr(result, "info", {}) or {}
     return {k: info[k] for k in ("band", "basis", "solver") if k in info}
-
-
-def _describe_choices(choices: dict) -> str:
-    band, basis = choices.get("band", {}), choices.get("basis", {})
-    if not band or not basis:
-        return ""
-    fmax = band.get("fmax_hz", math.nan)
-    how = "set by [plate] fmax" if band.get("user_fmax") else "automatic"
-    return (
-        f"modal band {fmax / 1e3:.3g} kHz ({how}), {basis.get('theory')} theory, "
-        f"{basis.get('n_modes')} modes up to {basis.get('top_frequency_hz', math.nan) / 1e3:.3g}"
-        f" kHz, truncation level {band.get('truncation_force_level', math.nan):.2g}"
-    )
 
 
 def write_results(out_dir, scene, result) -> list:
@@ -119,9 +104,10 @@ def run(args) -> int:
     scene = load_scene(args.scene)
     announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
     result = solve(scene)
-    line = _describe_choices(_choices(result))
-    if line:
-        note(line)
+    if scene.plate_model == "modal":
+        from tailbeam.coupled.auto import describe_choices
+
+        note(describe_choices(result.info))
     with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:
         files = write_results(tmp, scene, result)
     n = len(result.impacts)

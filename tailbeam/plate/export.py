@@ -1,17 +1,14 @@
 """Writing a modal basis for people: frequencies.csv, mode shapes as VTU (ParaView) and PNG.
 
-I/O only; the physics lives in the other modules.
+I/O only; the physics lives in the other modules. meshio and matplotlib are imported by the
+writers that need them, so writing frequencies.csv from a cached basis stays fast.
 """
 
 import csv
 import textwrap
 from pathlib import Path
 
-import meshio
 import numpy as np
-from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from skfem import MeshTri
 
 from tailbeam.modal import ModalBasis
 from tailbeam.plate.boundary import CONDITIONS, EDGES
@@ -47,12 +44,12 @@ def write_frequencies_csv(
     return path
 
 
-def write_vtu(
-    path, basis: ModalBasis, mesh: MeshTri | None = None, max_modes: int | None = None
-) -> Path:
+def write_vtu(path, basis: ModalBasis, mesh=None, max_modes: int | None = None) -> Path:
     """Mode shapes on a refined copy of the FE mesh (default: the basis's own mesh): one
     point field per mode, 'mode_001_<f>Hz' (deflection, 1/sqrt(kg)); in ParaView use
     'Warp By Scalar' to see the shape."""
+    import meshio
+
     mesh = mesh if mesh is not None else basis.mesh
     fine = mesh.refined(VTU_REFINE) if VTU_REFINE else mesh
     n = basis.n_modes if max_modes is None else min(max_modes, basis.n_modes)
@@ -94,10 +91,12 @@ def write_png(path, basis: ModalBasis, n_modes: int = PNG_MODES) -> Path:
     return Path(path)
 
 
-def build_modes_figure(basis: ModalBasis, n_modes: int = PNG_MODES) -> Figure:
+def build_modes_figure(basis: ModalBasis, n_modes: int = PNG_MODES):
     """A grid of the first modes' deflection (colour, nodal lines in black) with frequency and
     (m, n) label in the titles (tailbeam.plate.mode_labels) and the edge conditions drawn on
     every panel (solid: clamped, dashed: simply supported, dotted: free)."""
+    from matplotlib.figure import Figure
+
     plate = basis.plate
     n = min(n_modes, basis.n_modes)
     a, b = plate.size_x, plate.size_y
@@ -157,4 +156,6 @@ def _heading(basis: ModalBasis, width_in: float) -> str:
 
 
 def _legend_handles() -> list:
+    from matplotlib.lines import Line2D
+
     return [Line2D([], [], label=CONDITIONS[c], **style) for c, style in EDGE_STYLES.items()]
