@@ -79,7 +79,8 @@ def run_case(scene_toml: str, coal: tuple, *_after) -> dict:
             out["error"] = f"solver stopped: {result.message}".splitlines()[0]
         else:
             out["signals"] = {
-                name: np.asarray(a, dtype=np.float32) for name, (_t, a) in result.sensor_signals.items()
+                name: np.asarray(a, dtype=np.float32)
+                for name, (_t, a) in result.sensor_signals.items()
             }
             out["impacts"] = _impact_rows(result, coal)
             out["status"] = "ok"

@@ -331,10 +331,14 @@ def _seed_noise(data: dict, seed: int) -> None:
     for sensor in data.get("sensors", []) if isinstance(data.get("sensors"), list) else []:
         if isinstance(sensor, dict) and "noise" in sensor:
             noise = sensor["noise"]
-            sensor["noise"] = {**noise, "seed": seed} if isinstance(noise, dict) else {
-                "rms": noise,
-                "seed": seed,
-            }
+            sensor["noise"] = (
+                {**noise, "seed": seed}
+                if isinstance(noise, dict)
+                else {
+                    "rms": noise,
+                    "seed": seed,
+                }
+            )
 
 
 def make_case(spec: SweepSpec, params: dict, repeat: int, number: int):

@@ -16,6 +16,24 @@ import numpy as np
 from scipy import signal
 
 THIRD_OCTAVE_BASE_HZ = 1000.0  # band centres f_k = 1000 * 2^(k/3) Hz (base-2, IEC 61260)
+SCALAR_FEATURES = (
+    "rms",
+    "peak",
+    "crest_factor",
+    "kurtosis",
+    "skewness",
+    "spectral_centroid",
+    "energy",
+    "decay_rate",
+    "psd_power",
+    "psd_peak_hz",
+    "psd_median_hz",
+)
+
+
+def is_feature_name(name: str) -> bool:
+    """True for the names all_features returns (scalar features, band_<fc>Hz, wp_<k>)."""
+    return name in SCALAR_FEATURES or name.startswith(("band_", "wp_"))
 
 
 def rms(x):

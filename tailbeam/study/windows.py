@@ -115,10 +115,14 @@ def feature_table(path, *, window="impact", length=0.02, pre=0.0005):
                 frames.append(_features_frame(win, fs, sensors, meta))
             bar.update(len(ids))
     if dropped:
-        note(f"features: {dropped} impacts left out, their {length:g} s window runs past the record")
+        note(
+            f"features: {dropped} impacts left out, their {length:g} s window runs past the record"
+        )
     if not frames:
         raise InputError("DATASET", "no windows: the dataset has no impacts that fit a window")
     table = pd.concat(frames, ignore_index=True)
     if window == "impact":
         cases = cases.rename(columns={"label": "case_label"})
-    return table.join(cases.drop(columns=[c for c in cases.columns if c in table.columns]), on="case")
+    return table.join(
+        cases.drop(columns=[c for c in cases.columns if c in table.columns]), on="case"
+    )
