@@ -40,6 +40,19 @@ def case_table(ds):
     return ds[names].reset_coords().to_dataframe()[names]
 
 
+def add_noise(acc, fs: float, rms: float, seeds, sensors) -> np.ndarray:
+    """``acc`` (case, sensor, time) plus white noise of RMS ``rms`` (m/s^2), the model of
+    ``[[sensors]] noise`` (tailbeam.noise) drawn from each case's seed and sensor name."""
+    from tailbeam.noise import NoiseSpec, noise
+
+    out = np.array(acc, dtype=float)
+    for i, seed in enumerate(seeds):
+        spec = NoiseSpec(rms=rms, seed=int(seed))
+        for k, name in enumerate(sensors):
+            out[i, k] += noise(spec, f"added:{name}", out.shape[-1], fs)
+    return out
+
+
 def _impact_starts(impacts, case_ids, n_time, fs, length, pre):
     imp = impacts[impacts["case"].isin(case_ids)].copy()
     imp["start"] = np.round((imp["t_start"].to_numpy() - pre) * fs).astype(int).clip(0)
@@ -86,8 +99,14 @@ def _fixed_block(acc, ids, fs, length):
     return win, meta
 
 
-def feature_table(path, *, window="impact", length=0.02, pre=0.0005):
-    """The feature table of the dataset at ``path`` (see module docstring); a DataFrame."""
+def feature_table(
+    path, *, window="impact", length=0.02, pre=0.0005, noise_rms=0.0, first_only=False
+):
+    """The feature table of the dataset at ``path`` (see module docstring); a DataFrame.
+
+    ``noise_rms`` (m/s^2): white noise added to the stored signals first (add_noise), to
+    study separability against SNR without simulating again. ``first_only``: impact windows
+    of each ball's first impact only."""
     import pandas as pd
 
     if window not in ("impact", "fixed"):
@@ -98,6 +117,8 @@ def feature_table(path, *, window="impact", length=0.02, pre=0.0005):
     if n < 16:
         raise InputError("--length", f"must span at least 16 samples, {16 / fs:g} s")
     impacts = pd.read_parquet(folder / "impacts.parquet") if window == "impact" else None
+    if impacts is not None and first_only:
+        impacts = impacts[impacts["index"] == 1]
     cases = case_table(ds)
     sensors = [str(s) for s in ds["sensor"].values]
     frames, dropped = [], 0
@@ -105,7 +126,10 @@ def feature_table(path, *, window="impact", length=0.02, pre=0.0005):
     with task(f"features of {len(ids_all)} cases", total=len(ids_all), unit="cases") as bar:
         for lo in range(0, len(ids_all), BLOCK_CASES):
             ids = ids_all[lo : lo + BLOCK_CASES]
-            acc = ds["acceleration"].isel(case=slice(lo, lo + len(ids))).values.astype(float)
+            block = ds.isel(case=slice(lo, lo + len(ids)))
+            acc = block["acceleration"].values.astype(float)
+            if noise_rms > 0.0:
+                acc = add_noise(acc, fs, noise_rms, block["seed"].values, sensors)
             if window == "impact":
                 win, meta, d = _impact_block(acc, ids, impacts, fs, n, pre)
                 dropped += d
