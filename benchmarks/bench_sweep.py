@@ -38,7 +38,13 @@ def sweep_spec(n_cases: int):
         "duration": 0.025,
         "plate": {"model": "modal", "boundary": "SSSS", "fmax": 5000.0},
         "balls": [
-            {"name": "rock", "material": "coal", "radius": 0.03, "position": [0.0, 0.0, 0.0302]}
+            {
+                "name": "rock",
+                "material": "coal",
+                "radius": 0.03,
+                "position": [0.0, 0.0, 0.0302],
+                "velocity": [0.0, 0.0, -2.0],
+            }
         ],
         "sensors": [{"name": "S1", "position": [0.1, 0.15], "sample_rate": 12800.0}],
     }

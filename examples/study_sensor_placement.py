@@ -90,14 +90,25 @@ def visualize(rows: list, path) -> Path:
     ax.set_aspect("equal")
     ax.set_xlabel("sensor x (m)")
     ax.set_ylabel("sensor y (m)")
+    n = int(rows[0]["n_cases"])
+    se = float(np.sqrt(acc.mean() * (1 - acc.mean()) / n))  # binomial standard error
     ax.set_title(
-        f"coal vs sandstone per sensor position, SNR {SNR_DB:g} dB\n"
-        f"({rows[0]['n_cases']} cases; impacts anywhere in |x|, |y| <= 0.25 m; plate edges SSSS)",
+        f"coal vs sandstone per sensor position, SNR {SNR_DB:g} dB, {n} cases\n"
+        f"(impacts anywhere in |x|, |y| <= 0.25 m; SSSS edges; standard error ~{se:.2f})",
         fontsize=9,
     )
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return Path(path)
+
+
+def read_rows(path) -> list:
+    """Rows of a previous run's accuracy_by_position.csv (to redraw the figure)."""
+    with Path(path).open() as fh:
+        return [
+            {k: (v if k == "sensor" else float(v)) for k, v in r.items()}
+            for r in csv.DictReader(fh)
+        ]
 
 
 if __name__ == "__main__":

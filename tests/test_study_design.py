@@ -133,3 +133,20 @@ def test_cli_rejects_a_bad_sweep_before_any_work(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("tailbeam sweep: error: scene: cannot read") and "\n" not in err
     assert not out.exists()
+
+
+def test_core_imports_and_cli_work_without_the_study_extra():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "for m in ('dask', 'xarray', 'zarr', 'pyarrow', 'sklearn', 'pywt', 'pandas'):\n"
+        "    sys.modules[m] = None  # import of any of them now fails\n"
+        "import tailbeam, tailbeam.scene_file, tailbeam.sensor, tailbeam.noise\n"
+        "from tailbeam.cli import main\n"
+        "sys.exit(main(['sweep', 'missing.toml']))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 2, done.stderr
+    assert "pip install 'tailbeam[study]'" in done.stderr

@@ -37,7 +37,8 @@ LABEL_COLUMNS = (
     "n_gangue_impacts",
 )
 LEDGER_COLUMNS = ("case", "case_hash", "status", "error", "wall_time", "seed", "repeat")
-CHUNK_BYTES = 4 << 20  # target size of one Zarr chunk along case
+CHUNK_BYTES = 4 << 20  # target size of one Zarr chunk of signals along case
+CASE_COORD_CHUNK = 4096  # cases per chunk of the per-case coordinates
 
 
 def flat_params(params: dict) -> dict:
@@ -200,7 +201,11 @@ class DatasetStore:
         per_case = ds["acceleration"][0].nbytes
         chunk = max(1, CHUNK_BYTES // max(per_case, 1))
         n_sensor, n_time = ds["acceleration"].shape[1:]
-        return {"acceleration": {"chunks": (chunk, n_sensor, n_time)}}
+        enc = {"acceleration": {"chunks": (chunk, n_sensor, n_time)}}
+        for name, var in ds.coords.items():  # per-case values: few, large chunks
+            if var.dims and var.dims[0] == "case":
+                enc[name] = {"chunks": (CASE_COORD_CHUNK, *var.shape[1:])}
+        return enc
 
     def _batch_dataset(self, ok: list):
         import xarray as xr

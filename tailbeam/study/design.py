@@ -264,7 +264,9 @@ def set_value(data: dict, key: str, value) -> None:
             child[index] = value
             return
         else:
-            raise InputError(_field(key), f"{name!r} is not a list in the base scene")
+            raise InputError(
+                _field(key), f"{name!r} must be a list in the base scene to sweep one component"
+            )
 
 
 # -- expansion ------------------------------------------------------------------------------------
@@ -328,17 +330,13 @@ def case_labels(scene, coal: tuple) -> dict:
 
 
 def _seed_noise(data: dict, seed: int) -> None:
-    for sensor in data.get("sensors", []) if isinstance(data.get("sensors"), list) else []:
+    """Set the noise seed of every sensor that has noise to the case seed."""
+    sensors = data.get("sensors")
+    for sensor in sensors if isinstance(sensors, list) else []:
         if isinstance(sensor, dict) and "noise" in sensor:
             noise = sensor["noise"]
-            sensor["noise"] = (
-                {**noise, "seed": seed}
-                if isinstance(noise, dict)
-                else {
-                    "rms": noise,
-                    "seed": seed,
-                }
-            )
+            table = dict(noise) if isinstance(noise, dict) else {"rms": noise}
+            sensor["noise"] = {**table, "seed": seed}
 
 
 def make_case(spec: SweepSpec, params: dict, repeat: int, number: int):

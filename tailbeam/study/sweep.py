@@ -130,7 +130,13 @@ def run_sweep(spec, out_dir, *, workers=None, scheduler=None, client=None) -> di
     if not todo:
         note(f"sweep: all {len(cases)} cases already done in {out_dir}")
         return summary
-    note(f"sweep: {len(cases)} cases, {summary['skipped']} already done, {len(todo)} to run")
+    first = loads_scene(todo[0].toml)
+    n_time = int(first.duration * first.sensors[0].sample_rate + 1e-9) + 1
+    mb = len(todo) * len(first.sensors) * n_time * 4 / 1e6
+    note(
+        f"sweep: {len(cases)} cases, {summary['skipped']} already done, {len(todo)} to run "
+        f"(~{mb:.3g} MB of float32 signals to write)"
+    )
     own = client is None
     client = client or connect(workers, scheduler)
     t0 = time.perf_counter()
