@@ -125,6 +125,11 @@ def main(out_dir="out/benchmarks/bench_sweep", quick: bool = False, n_cases: int
         rows.append(dask_run(spec, w, target))
     for r in rows:
         r["cases_per_s"] = r["cases"] / r["wall_s"]
+        if "compute_s" in r:
+            # time the workers spent inside cases / the time they had: Dask's overhead shows
+            # here; a longer mean case time at more workers shows competition for the cores
+            r["mean_case_s"] = r["compute_s"] / r["cases"]
+            r["worker_occupancy"] = r["compute_s"] / (r["workers"] * r["wall_s"])
     one = next(r for r in rows if r["workers"] == 1 and "sweep" in r["run"])
     for r in rows:
         r["speedup_vs_1_worker"] = r["cases_per_s"] / one["cases_per_s"]
@@ -143,17 +148,19 @@ def _table(rows, path: Path, n: int) -> None:
         f"{n} single-impact cases (modal plate, cached basis), {cores} cores, load average "
         f"{os.getloadavg()[0]:.1f} at the end (a shared machine: other work competes).",
         "",
-        "| run | cases/s | speed-up vs 1 worker | writing / compute | peak worker RSS (MB) "
-        "| worker memory limit (MB) |",
-        "|---|---|---|---|---|---|",
+        "| run | cases/s | speed-up vs 1 worker | mean case time (s) | worker occupancy "
+        "| writing / compute | peak worker RSS (MB) | worker memory limit (MB) |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         share = f"{r['write_share_of_compute']:.1%}" if "write_s" in r else "-"
         rss = f"{r['peak_worker_rss_mb']:.0f}" if "peak_worker_rss_mb" in r else "-"
         lim = f"{r['worker_memory_limit_mb']:.0f}" if "worker_memory_limit_mb" in r else "-"
+        case = f"{r['mean_case_s']:.3f}" if "mean_case_s" in r else "-"
+        occ = f"{r['worker_occupancy']:.0%}" if "worker_occupancy" in r else "-"
         lines.append(
-            f"| {r['run']} | {r['cases_per_s']:.2f} | {r['speedup_vs_1_worker']:.2f} | {share} "
-            f"| {rss} | {lim} |"
+            f"| {r['run']} | {r['cases_per_s']:.2f} | {r['speedup_vs_1_worker']:.2f} | {case} "
+            f"| {occ} | {share} | {rss} | {lim} |"
         )
     path.write_text("\n".join(lines) + "\n")
     print(path.read_text())

@@ -35,12 +35,13 @@ def sensor_grid(n: int, half: float = 0.24) -> list:
     return [(f"x{i}y{j}", (float(x), float(y))) for j, y in enumerate(xs) for i, x in enumerate(xs)]
 
 
-def main(quick: bool = True, out="out/study_sensor_placement", workers=None) -> list:
-    """Run the sweep and score every sensor; returns rows (sensor, x, y, accuracy, ...)."""
+def main(quick: bool = True, out="out/study_sensor_placement", workers=None, client=None) -> list:
+    """Run the sweep and score every sensor; returns rows (sensor, x, y, accuracy, ...).
+    ``client``: a dask.distributed Client to run the sweep on (default: a local cluster)."""
     out = Path(out)
     grid = sensor_grid(2 if quick else 5)
     spec = parse_sweep(sweep_table(6 if quick else 150, base_scene(grid), seed=3))
-    run_sweep(spec, out / "dataset", workers=workers or (1 if quick else None))
+    run_sweep(spec, out / "dataset", workers=workers or (1 if quick else None), client=client)
     clean = feature_table(out / "dataset", length=WINDOW_S, first_only=True)
     ref = float(np.median(clean[[f"{name}.rms" for name, _ in grid]].to_numpy()))
     noisy = feature_table(

@@ -70,11 +70,12 @@ def sweep_table(samples: int, base: dict | None = None, seed: int = 1) -> dict:
     }
 
 
-def main(quick: bool = True, out="out/study_single_impacts", workers=None) -> list:
-    """Run the sweep (6 or 200 cases per class) and the SNR scan; returns its rows."""
+def main(quick: bool = True, out="out/study_single_impacts", workers=None, client=None) -> list:
+    """Run the sweep (6 or 200 cases per class) and the SNR scan; returns its rows.
+    ``client``: a dask.distributed Client to run the sweep on (default: a local cluster)."""
     out = Path(out)
     spec = parse_sweep(sweep_table(6 if quick else 200))
-    run_sweep(spec, out / "dataset", workers=workers or (1 if quick else None))
+    run_sweep(spec, out / "dataset", workers=workers or (1 if quick else None), client=client)
     rows = accuracy_vs_snr(
         out / "dataset", QUICK_SNR_DB if quick else SNR_DB, SENSOR, length=WINDOW_S,
         folds=3 if quick else 5,

@@ -25,9 +25,21 @@ def _load(name):
     return module
 
 
-def test_single_impact_study_quick(tmp_path):
+@pytest.fixture(scope="module")
+def client():
+    from dask.distributed import Client, LocalCluster
+
+    cluster = LocalCluster(
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
+    )
+    with Client(cluster) as c:
+        yield c
+    cluster.close()
+
+
+def test_single_impact_study_quick(tmp_path, client):
     module = _load("study_single_impacts")
-    rows = module.main(quick=True, out=tmp_path)
+    rows = module.main(quick=True, out=tmp_path, client=client)
     assert [r["snr_db"] for r in rows] == [math.inf, 0.0]
     assert rows[0]["n_cases"] == 12 and rows[0]["noise_rms"] == 0.0
     assert rows[1]["noise_rms"] == pytest.approx(rows[1]["reference_rms"])  # 0 dB
@@ -35,9 +47,9 @@ def test_single_impact_study_quick(tmp_path):
     assert (tmp_path / "accuracy_vs_snr.csv").is_file()
 
 
-def test_sensor_placement_study_quick(tmp_path):
+def test_sensor_placement_study_quick(tmp_path, client):
     module = _load("study_sensor_placement")
-    rows = module.main(quick=True, out=tmp_path)
+    rows = module.main(quick=True, out=tmp_path, client=client)
     assert [(r["x"], r["y"]) for r in rows] == [
         (-0.24, -0.24),
         (0.24, -0.24),
@@ -45,3 +57,12 @@ def test_sensor_placement_study_quick(tmp_path):
         (0.24, 0.24),
     ]
     assert all(r["n_cases"] == 12 for r in rows)
+
+
+def test_gangue_fraction_proxy_quick(tmp_path, client):
+    module = _load("study_gangue_fraction_proxy")
+    rows = module.main(quick=True, out=tmp_path, client=client)
+    assert [r["snr_db"] for r in rows] == [math.inf, 20.0]
+    assert rows[0]["n_cases"] == 6
+    assert 0.0 <= rows[0]["fraction_min"] <= rows[0]["fraction_max"] <= 1.0
+    assert rows[0]["mae"] >= 0.0
