@@ -49,37 +49,46 @@ def base_scene(sensors=((SENSOR, (0.1, 0.15)),)) -> dict:
     }
 
 
-def sweep_table(samples: int, base: dict | None = None, seed: int = 1) -> dict:
-    """The sweep: material grid x a random design of radius, speed and impact point."""
+def sweep_table(samples: int, base: dict | None = None, seed: int = 1, wide=True) -> dict:
+    """The sweep: material grid x a random design of radius, speed and impact point
+    (``wide``), or of the impact point only (radius 30 mm, 3 m/s: size and speed known)."""
 
     def uniform(lo, hi, kind="uniform"):
         return {"distribution": kind, "low": lo, "high": hi, "samples": samples}
 
-    return {
-        "scene": base or base_scene(),
-        "seed": seed,
-        "labels": {"coal": ["coal"]},
-        "axes": {
-            "balls.rock.material": ["coal", "sandstone"],
-            "balls.rock.radius": uniform(0.01, 0.1, "loguniform"),
-            "balls.rock.position[2]": {"follow": "balls.rock.radius", "offset": 0.0002},
-            "balls.rock.velocity[2]": uniform(-5.0, -1.0),
-            "balls.rock.position[0]": uniform(-0.25, 0.25),
-            "balls.rock.position[1]": uniform(-0.25, 0.25),
-        },
-    }
+    axes = {"balls.rock.material": ["coal", "sandstone"]}
+    if wide:
+        axes["balls.rock.radius"] = uniform(0.01, 0.1, "loguniform")
+        axes["balls.rock.position[2]"] = {"follow": "balls.rock.radius", "offset": 0.0002}
+        axes["balls.rock.velocity[2]"] = uniform(-5.0, -1.0)
+    axes["balls.rock.position[0]"] = uniform(-0.25, 0.25)
+    axes["balls.rock.position[1]"] = uniform(-0.25, 0.25)
+    scene = base or base_scene()
+    if not wide:
+        scene["balls"][0].update(radius=0.03, position=[0.0, 0.0, 0.0302], velocity=[0, 0, -3.0])
+    return {"scene": scene, "seed": seed, "labels": {"coal": ["coal"]}, "axes": axes}
+
+
+CONDITIONS = {"size and speed vary": True, "size and speed known": False}
 
 
 def main(quick: bool = True, out="out/study_single_impacts", workers=None, client=None) -> list:
-    """Run the sweep (6 or 200 cases per class) and the SNR scan; returns its rows.
-    ``client``: a dask.distributed Client to run the sweep on (default: a local cluster)."""
+    """Run the sweeps (6 or 200 cases per class; quick: the wide condition only) and the SNR
+    scans; returns their rows. ``client``: a dask.distributed Client to run the sweeps on
+    (default: a local cluster)."""
     out = Path(out)
-    spec = parse_sweep(sweep_table(6 if quick else 200))
-    run_sweep(spec, out / "dataset", workers=workers or (1 if quick else None), client=client)
-    rows = accuracy_vs_snr(
-        out / "dataset", QUICK_SNR_DB if quick else SNR_DB, SENSOR, length=WINDOW_S,
-        folds=3 if quick else 5,
-    )  # fmt: skip
+    rows = []
+    for k, (condition, wide) in enumerate(CONDITIONS.items()):
+        if quick and k:
+            break
+        folder = out / ("wide" if wide else "known") / "dataset"
+        spec = parse_sweep(sweep_table(6 if quick else 200, wide=wide))
+        run_sweep(spec, folder, workers=workers or (1 if quick else None), client=client)
+        scan = accuracy_vs_snr(
+            folder, QUICK_SNR_DB if quick else SNR_DB, SENSOR, length=WINDOW_S,
+            folds=3 if quick else 5,
+        )  # fmt: skip
+        rows += [{"condition": condition, **r} for r in scan]
     with (out / "accuracy_vs_snr.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
@@ -88,26 +97,34 @@ def main(quick: bool = True, out="out/study_single_impacts", workers=None, clien
 
 
 def visualize(rows: list, path) -> Path:
-    """Accuracy against SNR, with the majority-class floor."""
+    """Accuracy against SNR per condition, with the majority-class floor."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    finite = [r for r in rows if math.isfinite(r["snr_db"])]
-    clean = [r for r in rows if not math.isfinite(r["snr_db"])]
-    fig, ax = plt.subplots(figsize=(5.5, 3.8), constrained_layout=True)
-    ax.plot([r["snr_db"] for r in finite], [r["accuracy"] for r in finite], "o-", label="forest")
-    ax.plot([r["snr_db"] for r in finite], [r["dummy_accuracy"] for r in finite], "k--",
+    fig, ax = plt.subplots(figsize=(5.8, 3.9), constrained_layout=True)
+    for condition, colour in zip(CONDITIONS, ("tab:blue", "tab:orange"), strict=True):
+        mine = [r for r in rows if r["condition"] == condition]
+        finite = [r for r in mine if math.isfinite(r["snr_db"])]
+        clean = [r for r in mine if not math.isfinite(r["snr_db"])]
+        if not mine:
+            continue
+        n = mine[0]["n_cases"]
+        ax.plot([r["snr_db"] for r in finite], [r["accuracy"] for r in finite], "o-",
+                color=colour, label=f"{condition} ({n} cases)")  # fmt: skip
+        if clean:
+            ax.axhline(clean[0]["accuracy"], color=colour, lw=1, ls=":",
+                       label=f"{condition}, no added noise")  # fmt: skip
+    floor = [r for r in rows if math.isfinite(r["snr_db"])]
+    ax.plot([r["snr_db"] for r in floor], [r["dummy_accuracy"] for r in floor], "k--", lw=1,
             label="majority class")  # fmt: skip
-    if clean:
-        ax.axhline(clean[0]["accuracy"], color="tab:green", lw=1, label="no added noise")
     ax.set_xlabel("SNR re median first-impact window RMS (dB)")
-    ax.set_ylabel("accuracy, grouped CV")
+    ax.set_ylabel("accuracy, grouped 5-fold CV")
     ax.set_ylim(0.4, 1.02)
-    n = rows[0]["n_cases"]
-    ax.set_title(f"coal vs sandstone, single impacts, one sensor ({n} cases)", fontsize=9)
-    ax.legend(fontsize=8, loc="upper left")
+    ax.set_title("coal vs sandstone from one sensor, single impacts anywhere on the plate",
+                 fontsize=9)  # fmt: skip
+    ax.legend(fontsize=7, loc="lower right")
     ax.grid(alpha=0.3)
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -123,7 +140,8 @@ if __name__ == "__main__":
     result = main(quick=not args.full, out=args.out, workers=args.workers)
     for r in result:
         print(
-            f"SNR {r['snr_db']:>5} dB: accuracy {r['accuracy']:.3f}, F1 {r['f1_macro']:.3f} "
-            f"(majority {r['dummy_accuracy']:.3f}; noise {r['noise_rms']:.3g} m/s^2)"
+            f"{r['condition']}: SNR {r['snr_db']:>5} dB: accuracy {r['accuracy']:.3f}, "
+            f"F1 {r['f1_macro']:.3f} (majority {r['dummy_accuracy']:.3f}; "
+            f"noise {r['noise_rms']:.3g} m/s^2)"
         )
     print(visualize(result, Path(args.out) / "accuracy_vs_snr.png"))
