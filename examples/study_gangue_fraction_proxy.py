@@ -16,7 +16,6 @@ the median window RMS; the mean predictor is the floor. Separability of simulate
 """
 
 import argparse
-import csv
 import math
 from pathlib import Path
 
@@ -24,6 +23,7 @@ import numpy as np
 
 from tailbeam.study.design import parse_sweep
 from tailbeam.study.learn import learn
+from tailbeam.study.separability import write_rows
 from tailbeam.study.sweep import run_sweep
 from tailbeam.study.windows import feature_table
 
@@ -100,10 +100,7 @@ def main(
                 "fraction_max": float(table["gangue_fraction"].max()),
             }
         )
-    with (out / "gangue_fraction_vs_snr.csv").open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "gangue_fraction_vs_snr.csv", rows)
     return rows
 
 

@@ -23,6 +23,7 @@ from study_single_impacts import WINDOW_S, base_scene, sweep_table  # noqa: E402
 
 from tailbeam.study.design import parse_sweep  # noqa: E402
 from tailbeam.study.learn import learn  # noqa: E402
+from tailbeam.study.separability import write_rows  # noqa: E402
 from tailbeam.study.sweep import run_sweep  # noqa: E402
 from tailbeam.study.windows import feature_table  # noqa: E402
 
@@ -62,10 +63,7 @@ def main(quick: bool = True, out="out/study_sensor_placement", workers=None, cli
                 "noise_rms": ref / 10 ** (SNR_DB / 20),
             }
         )
-    with (out / "accuracy_by_position.csv").open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "accuracy_by_position.csv", rows)
     return rows
 
 

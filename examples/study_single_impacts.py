@@ -20,7 +20,7 @@ import math
 from pathlib import Path
 
 from tailbeam.study.design import parse_sweep
-from tailbeam.study.separability import accuracy_vs_snr
+from tailbeam.study.separability import accuracy_vs_snr, write_rows
 from tailbeam.study.sweep import run_sweep
 
 SENSOR = "S1"
@@ -89,10 +89,7 @@ def main(quick: bool = True, out="out/study_single_impacts", workers=None, clien
             folds=3 if quick else 5,
         )  # fmt: skip
         rows += [{"condition": condition, **r} for r in scan]
-    with (out / "accuracy_vs_snr.csv").open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "accuracy_vs_snr.csv", rows)
     return rows
 
 
@@ -103,32 +100,40 @@ def visualize(rows: list, path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(5.8, 3.9), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(5.8, 4.6), constrained_layout=True)
     for condition, colour in zip(CONDITIONS, ("tab:blue", "tab:orange"), strict=True):
         mine = [r for r in rows if r["condition"] == condition]
         finite = [r for r in mine if math.isfinite(r["snr_db"])]
         clean = [r for r in mine if not math.isfinite(r["snr_db"])]
         if not mine:
             continue
-        n = mine[0]["n_cases"]
+        n = int(mine[0]["n_cases"])
         ax.plot([r["snr_db"] for r in finite], [r["accuracy"] for r in finite], "o-",
                 color=colour, label=f"{condition} ({n} cases)")  # fmt: skip
         if clean:
             ax.axhline(clean[0]["accuracy"], color=colour, lw=1, ls=":",
                        label=f"{condition}, no added noise")  # fmt: skip
-    floor = [r for r in rows if math.isfinite(r["snr_db"])]
+    first = [r for r in rows if r["condition"] == rows[0]["condition"]]
+    floor = [r for r in first if math.isfinite(r["snr_db"])]
     ax.plot([r["snr_db"] for r in floor], [r["dummy_accuracy"] for r in floor], "k--", lw=1,
             label="majority class")  # fmt: skip
-    ax.set_xlabel("SNR re median first-impact window RMS (dB)")
+    ax.set_xlabel("SNR re the median first-impact window RMS of each dataset (dB)")
     ax.set_ylabel("accuracy, grouped 5-fold CV")
     ax.set_ylim(0.4, 1.02)
     ax.set_title("coal vs sandstone from one sensor, single impacts anywhere on the plate",
                  fontsize=9)  # fmt: skip
-    ax.legend(fontsize=7, loc="lower right")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
     ax.grid(alpha=0.3)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return Path(path)
+
+
+def read_rows(path) -> list:
+    """Rows of a previous run's accuracy_vs_snr.csv (to redraw the figure)."""
+    with Path(path).open() as fh:
+        text = {"condition"}
+        return [{k: v if k in text else float(v) for k, v in r.items()} for r in csv.DictReader(fh)]
 
 
 if __name__ == "__main__":

@@ -27,11 +27,11 @@ def _load(name):
 
 @pytest.fixture(scope="module")
 def client():
-    from dask.distributed import Client, LocalCluster
+    from dask.distributed import Client
 
-    cluster = LocalCluster(
-        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
-    )
+    from tailbeam.study.sweep import local_cluster
+
+    cluster = local_cluster(1)
     with Client(cluster) as c:
         yield c
     cluster.close()

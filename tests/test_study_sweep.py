@@ -52,15 +52,9 @@ scene = "base.toml"
 
 @pytest.fixture(scope="module")
 def scheduler():
-    from dask.distributed import LocalCluster
+    from tailbeam.study.sweep import local_cluster
 
-    cluster = LocalCluster(
-        n_workers=2,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-    )
+    cluster = local_cluster(2)
     assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
     yield cluster.scheduler_address
     cluster.close()

@@ -148,7 +148,9 @@ def importance_figure(scores: dict, path, top: int = 15):
     fig, ax = plt.subplots(figsize=(5.5, 0.25 * len(items) + 1.2), constrained_layout=True)
     ax.barh([k for k, _ in items], [v for _, v in items], color="tab:blue")
     ax.set_xlabel("importance (mean impurity decrease; all features sum to 1)")
-    ax.set_title(f"random forest, target {scores['target']} (band_, wp_: energy fractions)", fontsize=9)
+    ax.set_title(
+        f"random forest, target {scores['target']} (band_, wp_: energy fractions)", fontsize=9
+    )
     ax.tick_params(axis="y", labelsize=8)
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from tailbeam.results_io import write_csv
 from tailbeam.study.learn import learn
 from tailbeam.study.windows import feature_table
 
@@ -44,3 +45,9 @@ def accuracy_vs_snr(path, snr_db, sensor: str, *, length=0.02, folds=5, ref_rms=
             }
         )
     return rows
+
+
+def write_rows(path, rows: list):
+    """Write a list of dicts (one header, the first row's keys) as CSV; returns the path."""
+    keys = list(rows[0])
+    return write_csv(path, keys, ([r[k] for k in keys] for r in rows))

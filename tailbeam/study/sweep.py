@@ -34,13 +34,29 @@ def default_workers() -> int:
         return os.cpu_count() or 1
 
 
-def connect(workers: int | None = None, scheduler: str | None = None):
-    """A dask.distributed Client: to ``scheduler`` if given, else to a new LocalCluster of
-    ``workers`` single-threaded processes (default: one per core). Close it when done
-    (``client.close()``; a local cluster closes with it)."""
+def local_cluster(n_workers: int):
+    """A dask.distributed LocalCluster of ``n_workers`` single-threaded processes on
+    127.0.0.1, without dashboard; the scheduler's HTTP routes take a free port (not 8787,
+    so sweeps and other Dask users on one machine do not collide)."""
     import logging
 
-    from dask.distributed import Client, LocalCluster
+    from dask.distributed import LocalCluster
+
+    return LocalCluster(
+        n_workers=n_workers,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+        silence_logs=logging.ERROR,
+    )
+
+
+def connect(workers: int | None = None, scheduler: str | None = None):
+    """A dask.distributed Client: to ``scheduler`` if given, else to a new local_cluster of
+    ``workers`` processes (default: one per core). Close it with close_client."""
+    from dask.distributed import Client
 
     if scheduler:
         try:
@@ -50,14 +66,7 @@ def connect(workers: int | None = None, scheduler: str | None = None):
     n = workers or default_workers()
     if workers is None:
         note(f"sweep: {n} local Dask workers, one per core (--workers N to change)")
-    cluster = LocalCluster(
-        n_workers=n,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-    )
+    cluster = local_cluster(n)
     client = Client(cluster)
     client._tailbeam_cluster = cluster  # closed together in close_client
     return client
