@@ -36,17 +36,21 @@ def sensor_grid(n: int, half: float = 0.24) -> list:
     return [(f"x{i}y{j}", (float(x), float(y))) for j, y in enumerate(xs) for i, x in enumerate(xs)]
 
 
-def main(quick: bool = True, out="out/study_sensor_placement", workers=None, client=None) -> list:
+def main(
+    quick: bool = True, out="out/study_sensor_placement", workers=None, client=None, wide=True
+) -> list:
     """Run the sweep and score every sensor; returns rows (sensor, x, y, accuracy, ...).
-    ``client``: a dask.distributed Client to run the sweep on (default: a local cluster)."""
+    ``client``: a dask.distributed Client to run the sweep on (default: a local cluster).
+    ``wide``: radius and speed vary as in study 1; False: 30 mm at 3 m/s (known), SNR 0 dB."""
     out = Path(out)
     grid = sensor_grid(2 if quick else 5)
-    spec = parse_sweep(sweep_table(6 if quick else 150, base_scene(grid), seed=3))
+    spec = parse_sweep(sweep_table(6 if quick else 150, base_scene(grid), seed=3, wide=wide))
     run_sweep(spec, out / "dataset", workers=workers or (1 if quick else None), client=client)
     clean = feature_table(out / "dataset", length=WINDOW_S, first_only=True)
     ref = float(np.median(clean[[f"{name}.rms" for name, _ in grid]].to_numpy()))
+    snr = SNR_DB if wide else 0.0
     noisy = feature_table(
-        out / "dataset", length=WINDOW_S, first_only=True, noise_rms=ref / 10 ** (SNR_DB / 20)
+        out / "dataset", length=WINDOW_S, first_only=True, noise_rms=ref / 10 ** (snr / 20)
     )
     rows = []
     for name, (x, y) in grid:
@@ -60,7 +64,9 @@ def main(quick: bool = True, out="out/study_sensor_placement", workers=None, cli
                 "f1_macro": s["f1_macro"],
                 "dummy_accuracy": s["dummy"]["accuracy"],
                 "n_cases": s["n_cases"],
-                "noise_rms": ref / 10 ** (SNR_DB / 20),
+                "noise_rms": ref / 10 ** (snr / 20),
+                "snr_db": snr,
+                "condition": "size and speed vary" if wide else "30 mm at 3 m/s",
             }
         )
     write_rows(out / "accuracy_by_position.csv", rows)
@@ -74,7 +80,7 @@ def visualize(rows: list, path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(5.2, 4.4), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(5.8, 4.6), constrained_layout=True)
     ax.add_patch(plt.Rectangle((-0.3, -0.3), 0.6, 0.6, fill=False, lw=1.5, color="0.3"))
     acc = np.array([r["accuracy"] for r in rows])
     sc = ax.scatter([r["x"] for r in rows], [r["y"] for r in rows], c=acc, s=500, marker="s",
@@ -92,8 +98,9 @@ def visualize(rows: list, path) -> Path:
     n = int(rows[0]["n_cases"])
     se = float(np.sqrt(acc.mean() * (1 - acc.mean()) / n))  # binomial standard error
     ax.set_title(
-        f"coal vs sandstone per sensor position, SNR {SNR_DB:g} dB, {n} cases\n"
-        f"(impacts anywhere in |x|, |y| <= 0.25 m; SSSS edges; standard error ~{se:.2f})",
+        f"coal vs sandstone per sensor position, {rows[0].get('condition', 'size and speed vary')}"
+        f", SNR {rows[0].get('snr_db', SNR_DB):g} dB\n({n} cases, impacts over |x|, |y| <= "
+        f"0.25 m, SSSS edges; standard error ~{se:.2f})",
         fontsize=9,
     )
     fig.savefig(path, dpi=120)
@@ -104,10 +111,8 @@ def visualize(rows: list, path) -> Path:
 def read_rows(path) -> list:
     """Rows of a previous run's accuracy_by_position.csv (to redraw the figure)."""
     with Path(path).open() as fh:
-        return [
-            {k: (v if k == "sensor" else float(v)) for k, v in r.items()}
-            for r in csv.DictReader(fh)
-        ]
+        text = ("sensor", "condition")
+        return [{k: v if k in text else float(v) for k, v in r.items()} for r in csv.DictReader(fh)]
 
 
 if __name__ == "__main__":
@@ -115,8 +120,9 @@ if __name__ == "__main__":
     parser.add_argument("--full", action="store_true", help="5 x 5 sensors, 150 cases per class")
     parser.add_argument("--out", default="out/study_sensor_placement")
     parser.add_argument("--workers", type=int, default=None)
+    parser.add_argument("--known", action="store_true", help="radius 30 mm, 3 m/s; SNR 0 dB")
     args = parser.parse_args()
-    result = main(quick=not args.full, out=args.out, workers=args.workers)
+    result = main(quick=not args.full, out=args.out, workers=args.workers, wide=not args.known)
     for r in result:
         print(f"{r['sensor']} ({r['x']:+.2f}, {r['y']:+.2f}) m: accuracy {r['accuracy']:.3f}")
     print(visualize(result, Path(args.out) / "accuracy_by_position.png"))
