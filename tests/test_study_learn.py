@@ -90,3 +90,13 @@ def test_cross_validation_is_grouped_by_case():
     table["label"] = labels
     scores = learn(table, "label", folds=5)
     assert scores["accuracy"] < 0.75  # near 0.5; ungrouped folds would give ~1.0
+
+
+def test_undefined_features_are_imputed_not_dropped():
+    rng = np.random.default_rng(1)
+    table = pd.DataFrame(rng.standard_normal((30, 2)), columns=["S1.rms", "S1.decay_rate"])
+    table.loc[::4, "S1.decay_rate"] = np.nan
+    table["case"] = np.arange(30)
+    table["label"] = np.where(table["S1.rms"] > 0, "gangue", "coal")
+    scores = learn(table, "label", folds=3)
+    assert scores["n_rows"] == 30 and np.sum(scores["confusion"]) == 30
