@@ -92,7 +92,9 @@ def dask_run(spec, n_workers: int, out: Path) -> dict:
         limit = client.run(lambda dask_worker: dask_worker.memory_manager.memory_limit)
     finally:
         close_client(client)
-    compute = float(pd.read_csv(out / "cases.csv")["wall_time"].sum())
+    ledger = pd.read_csv(out / "cases.csv")
+    compute = float(ledger["wall_time"].sum())
+    cpu = float(ledger["cpu_time"].sum())
     return {
         "run": f"sweep, LocalCluster {n_workers} worker(s)",
         "workers": n_workers,
@@ -100,6 +102,7 @@ def dask_run(spec, n_workers: int, out: Path) -> dict:
         "cases": summary["ok"] + summary["failed"],
         "failed": summary["failed"],
         "compute_s": compute,
+        "cpu_s": cpu,
         "write_s": summary["write_time_s"],
         "write_share_of_compute": summary["write_time_s"] / compute,
         "peak_worker_rss_mb": max(rss.values()),
@@ -130,6 +133,12 @@ def main(out_dir="out/benchmarks/bench_sweep", quick: bool = False, n_cases: int
             # here; a longer mean case time at more workers shows competition for the cores
             r["mean_case_s"] = r["compute_s"] / r["cases"]
             r["worker_occupancy"] = r["compute_s"] / (r["workers"] * r["wall_s"])
+            # share of a case's wall time its worker had a core: < 1 when cores are contended
+            r["cpu_share"] = r["cpu_s"] / r["compute_s"]
+            # throughput if every worker had its own core (an estimate, not a measurement)
+            r["cases_per_s_own_cores"] = (
+                r["workers"] * r["worker_occupancy"] / (r["cpu_s"] / r["cases"])
+            )
     one = next(r for r in rows if r["workers"] == 1 and "sweep" in r["run"])
     for r in rows:
         r["speedup_vs_1_worker"] = r["cases_per_s"] / one["cases_per_s"]
@@ -148,9 +157,10 @@ def _table(rows, path: Path, n: int) -> None:
         f"{n} single-impact cases (modal plate, cached basis), {cores} cores, load average "
         f"{os.getloadavg()[0]:.1f} at the end (a shared machine: other work competes).",
         "",
-        "| run | cases/s | speed-up vs 1 worker | mean case time (s) | worker occupancy "
-        "| writing / compute | peak worker RSS (MB) | worker memory limit (MB) |",
-        "|---|---|---|---|---|---|---|---|",
+        "| run | cases/s | speed-up vs 1 worker | mean case time (s) | CPU share of case time "
+        "| worker occupancy | cases/s if each worker had a core (estimate) | writing / compute "
+        "| peak worker RSS (MB) | worker memory limit (MB) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         share = f"{r['write_share_of_compute']:.1%}" if "write_s" in r else "-"
@@ -158,9 +168,11 @@ def _table(rows, path: Path, n: int) -> None:
         lim = f"{r['worker_memory_limit_mb']:.0f}" if "worker_memory_limit_mb" in r else "-"
         case = f"{r['mean_case_s']:.3f}" if "mean_case_s" in r else "-"
         occ = f"{r['worker_occupancy']:.0%}" if "worker_occupancy" in r else "-"
+        cpu = f"{r['cpu_share']:.0%}" if "cpu_share" in r else "-"
+        own = f"{r['cases_per_s_own_cores']:.2f}" if "cpu_share" in r else "-"
         lines.append(
             f"| {r['run']} | {r['cases_per_s']:.2f} | {r['speedup_vs_1_worker']:.2f} | {case} "
-            f"| {occ} | {share} | {rss} | {lim} |"
+            f"| {cpu} | {occ} | {own} | {share} | {rss} | {lim} |"
         )
     path.write_text("\n".join(lines) + "\n")
     print(path.read_text())

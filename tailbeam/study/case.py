@@ -65,13 +65,15 @@ def _impact_rows(result, coal: tuple) -> list:
 
 
 def run_case(scene_toml: str, coal: tuple, *_after) -> dict:
-    """Simulate one case. Returns {"status": "ok" | "failed", "error", "wall_time" (s),
+    """Simulate one case. Returns {"status": "ok" | "failed", "error", "wall_time",
+    "cpu_time" (s, this process),
     "signals": {sensor: float32 array m/s^2}, "impacts": [row dicts], "n_coal_impacts",
     "n_gangue_impacts"}. ``_after`` are ignored (Dask dependencies, e.g. the warmed basis)."""
     from tailbeam.commands.simulate import solve
     from tailbeam.scene_file import loads_scene
 
     t0 = time.perf_counter()
+    c0 = time.process_time()
     out = {"status": "failed", "error": "", "signals": {}, "impacts": []}
     try:
         result = solve(loads_scene(scene_toml))
@@ -90,4 +92,5 @@ def run_case(scene_toml: str, coal: tuple, *_after) -> dict:
     out["n_coal_impacts"] = classes.count("coal")
     out["n_gangue_impacts"] = classes.count("gangue")
     out["wall_time"] = time.perf_counter() - t0
+    out["cpu_time"] = time.process_time() - c0
     return out

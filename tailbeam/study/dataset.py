@@ -11,7 +11,8 @@
 - ``impacts.parquet``: one row per impact of every finished case (``case``, ``case_hash``, the
   impacts.csv columns, the ball's ``material`` and ``class``).
 - ``cases.csv``: one row per case run so far: ``case``, ``case_hash``, ``status`` (ok | failed),
-  ``error`` (one line), ``wall_time`` (s), seed, repeat, labels and the swept values.
+  ``error`` (one line), ``wall_time`` and ``cpu_time`` (s, on the worker), seed, repeat,
+  labels and the swept values.
 
 Order of writes per batch: impacts.parquet (whole table, atomic rename), then the Zarr append,
 then cases.csv. The Zarr store is the record of finished cases: on opening, impact rows of
@@ -36,7 +37,16 @@ LABEL_COLUMNS = (
     "n_coal_impacts",
     "n_gangue_impacts",
 )
-LEDGER_COLUMNS = ("case", "case_hash", "status", "error", "wall_time", "seed", "repeat")
+LEDGER_COLUMNS = (
+    "case",
+    "case_hash",
+    "status",
+    "error",
+    "wall_time",
+    "cpu_time",
+    "seed",
+    "repeat",
+)
 CHUNK_BYTES = 4 << 20  # target size of one Zarr chunk of signals along case
 CASE_COORD_CHUNK = 4096  # cases per chunk of the per-case coordinates
 
@@ -147,6 +157,7 @@ class DatasetStore:
                 "status": result["status"],
                 "error": result["error"],
                 "wall_time": result["wall_time"],
+                "cpu_time": result.get("cpu_time", float("nan")),
                 "seed": case.seed,
                 "repeat": case.repeat,
                 **case.labels,
@@ -220,7 +231,8 @@ class DatasetStore:
             "sensor": ("sensor", np.array(names, dtype=object)),
             "time": ("time", np.arange(n_time) / fs, {"units": "s"}),
         }
-        for col in [c for c in ok[0][0] if c not in ("case", "status", "error", "wall_time")]:
+        skip = ("case", "status", "error", "wall_time", "cpu_time")
+        for col in [c for c in ok[0][0] if c not in skip]:
             values = np.array([r[col] for r, *_ in ok])
             coords[col] = ("case", values.astype(object) if values.dtype.kind == "U" else values)
         for axis, unit in ((0, "sensor_x"), (1, "sensor_y")):

@@ -124,6 +124,7 @@ def _result_of(fut) -> dict:
         "n_coal_impacts": 0,
         "n_gangue_impacts": 0,
         "wall_time": float("nan"),
+        "cpu_time": float("nan"),
     }
 
 
