@@ -79,8 +79,7 @@ class DatasetStore:
     def __init__(self, out_dir, sweep_text: str = ""):
         import pandas as pd
 
-        self.dir = Path(out_dir)
-        self.dir.mkdir(parents=True, exist_ok=True)
+        self.dir = Path(out_dir)  # created by the first record()
         self.zarr_path = self.dir / "dataset.zarr"
         self.sweep_text = sweep_text
         csv = self.dir / "cases.csv"
@@ -148,6 +147,7 @@ class DatasetStore:
 
     def record(self, batch: list) -> None:
         """Write a batch of (Case, result dict, Scene) of finished or failed cases."""
+        self.dir.mkdir(parents=True, exist_ok=True)
         rows, ok = [], []
         ids = self.case_ids([case.hash for case, _r, _s in batch])
         for (case, result, scene), cid in zip(batch, ids, strict=True):
