@@ -11,7 +11,6 @@ Separability of simulated signals, one model of the plate (SSSS, 1 % damping, mo
 """
 
 import argparse
-import csv
 import sys
 from pathlib import Path
 
@@ -21,6 +20,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 from study_single_impacts import WINDOW_S, base_scene, sweep_table  # noqa: E402
 
+from tailbeam.study import separability  # noqa: E402
 from tailbeam.study.design import parse_sweep  # noqa: E402
 from tailbeam.study.learn import learn  # noqa: E402
 from tailbeam.study.separability import write_rows  # noqa: E402
@@ -110,9 +110,7 @@ def visualize(rows: list, path) -> Path:
 
 def read_rows(path) -> list:
     """Rows of a previous run's accuracy_by_position.csv (to redraw the figure)."""
-    with Path(path).open() as fh:
-        text = ("sensor", "condition")
-        return [{k: v if k in text else float(v) for k, v in r.items()} for r in csv.DictReader(fh)]
+    return separability.read_rows(path, text=("sensor", "condition"))
 
 
 if __name__ == "__main__":

@@ -15,10 +15,10 @@ separability of simulated signals under this model, not a field accuracy.
 """
 
 import argparse
-import csv
 import math
 from pathlib import Path
 
+from tailbeam.study import separability
 from tailbeam.study.design import parse_sweep
 from tailbeam.study.separability import accuracy_vs_snr, write_rows
 from tailbeam.study.sweep import run_sweep
@@ -131,9 +131,7 @@ def visualize(rows: list, path) -> Path:
 
 def read_rows(path) -> list:
     """Rows of a previous run's accuracy_vs_snr.csv (to redraw the figure)."""
-    with Path(path).open() as fh:
-        text = {"condition"}
-        return [{k: v if k in text else float(v) for k, v in r.items()} for r in csv.DictReader(fh)]
+    return separability.read_rows(path, text=("condition",))
 
 
 if __name__ == "__main__":

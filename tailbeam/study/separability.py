@@ -51,3 +51,12 @@ def write_rows(path, rows: list):
     """Write a list of dicts (one header, the first row's keys) as CSV; returns the path."""
     keys = list(rows[0])
     return write_csv(path, keys, ([r[k] for k in keys] for r in rows))
+
+
+def read_rows(path, text=()) -> list:
+    """Rows written by write_rows, numbers as floats except the columns named in ``text``."""
+    import csv
+    from pathlib import Path
+
+    with Path(path).open() as fh:
+        return [{k: v if k in text else float(v) for k, v in r.items()} for r in csv.DictReader(fh)]
