@@ -129,3 +129,17 @@ def test_sweep_records_failures_resumes_and_appends(tmp_path, scheduler, capsys)
     assert sorted(pd.read_parquet(out / "impacts.parquet")["case"].unique()) == sorted(
         ds["case"].values
     )
+
+
+def test_progress_lines_show_failures(monkeypatch, capsys):
+    from tailbeam import progress
+
+    monkeypatch.setattr(progress, "DELAY_S", 0.0)
+    with progress.task("sweep of 3 cases", total=3, unit="cases") as bar:
+        bar.update(1)
+        bar.set_postfix("1 failed")
+        bar.update(2)
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines[0].startswith("tailbeam: sweep of 3 cases: 1/3 cases, ")
+    assert "left" in lines[0]  # time left
+    assert lines[-1].startswith("tailbeam: sweep of 3 cases: 3/3 cases (1 failed), ")

@@ -161,6 +161,7 @@ def run_sweep(spec, out_dir, *, workers=None, scheduler=None, client=None) -> di
                 fut.release()
                 summary[result["status"]] += 1
                 if result["status"] != "ok":
+                    bar.set_postfix(f"{summary['failed']} failed")
                     note(f"case {case.hash[:12]} failed ({summary['failed']} so far): "
                          f"{result['error']}")  # fmt: skip
                 batch.append((case, result, scene))
