@@ -18,6 +18,9 @@ COMMANDS = {
     "reproduce": "reproduce the paper's rigid-plate scenarios (4.1-4.3) and check its claims",
     "simulate": "simulate a scene file (TOML) and write impacts.csv and time series",
     "modes": "compute the plate's natural frequencies and mode shapes",
+    "sweep": "run a parameter sweep on Dask and write a labelled dataset (Zarr, Parquet)",
+    "features": "compute signal features of a sweep dataset into features.parquet",
+    "learn": "cross-validated scikit-learn baseline: how separable coal and gangue are",
 }
 
 

@@ -46,6 +46,7 @@ class _LogBar:
         self.n = 0
         self.start = time.monotonic()
         self.last = None  # time of the last line written
+        self.extra = ""  # set_postfix text, e.g. "3 failed"
 
     def _line(self, final=False):
         elapsed = time.monotonic() - self.start
@@ -54,7 +55,7 @@ class _LogBar:
         if not self.total and not self.n:  # nothing counted: elapsed time only
             done = unit = ""
         else:
-            unit += ","
+            unit += (f" ({self.extra})" if self.extra else "") + ","
         tail = "done" if final else "..."
         eta = ""
         if not final and self.total and 0 < self.n < self.total:
@@ -78,6 +79,9 @@ class _LogBar:
 
     def set_total(self, total):
         self.total = total
+
+    def set_postfix(self, text: str):
+        self.extra = text
 
     def close(self):
         if self.last is not None or time.monotonic() - self.start >= DELAY_S:
@@ -107,6 +111,9 @@ class _TqdmBar:
         self._bar.total = total
         self._bar.refresh()
 
+    def set_postfix(self, text: str):
+        self._bar.set_postfix_str(text)
+
     def close(self):
         self._bar.close()
 
@@ -118,13 +125,17 @@ class _NoBar:
     def set_total(self, total):
         pass
 
+    def set_postfix(self, text: str):
+        pass
+
     def close(self):
         pass
 
 
 @contextlib.contextmanager
 def task(description: str, total: float | None = None, unit: str = ""):
-    """Context manager yielding a bar with ``update(n)`` and ``set_total(total)``.
+    """Context manager yielding a bar with ``update(n)``, ``set_total(total)`` and
+    ``set_postfix(text)`` (a short status shown after the count, e.g. "2 failed").
 
     Parameters
     ----------

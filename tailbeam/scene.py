@@ -14,6 +14,7 @@ from tailbeam.errors import (
     require_vector,
 )
 from tailbeam.materials import Material
+from tailbeam.noise import NoiseSpec
 
 # Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams'
 # default penetration depth. c = 300 N s/m was chosen by running the paper's three scenarios over
@@ -127,6 +128,7 @@ class SensorSpec:
     sample_rate: float = 51200.0
     bandwidth_hz: float | None = None
     mounted_resonance_hz: float | None = None
+    noise: NoiseSpec | None = None  # measurement noise added to the output (tailbeam.noise)
 
     def __post_init__(self):
         field_ = f"sensors[{self.name}]"

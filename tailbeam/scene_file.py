@@ -21,6 +21,7 @@ from tailbeam.errors import (
     require_vector,
 )
 from tailbeam.materials import BUILTIN_MATERIALS, Material, get_material
+from tailbeam.noise import NoiseSpec
 from tailbeam.preflight import check_scene
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene, SensorSpec
 
@@ -54,7 +55,8 @@ MODAL_KEYS = (
 )
 MATERIAL_KEYS = ("density", "youngs_modulus", "poisson_ratio")
 BALL_KEYS = ("name", "material", "radius", "position", "velocity")
-SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance")
+SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance", "noise")
+NOISE_KEYS = ("rms", "background", "band", "seed")
 
 
 def load_scene(path) -> Scene:
@@ -311,6 +313,8 @@ def _parse_sensors(value, plate: Plate) -> tuple:
         ):
             if key in t:
                 kwargs[arg] = require_real(f"{field}.{key}", t[key])
+        if "noise" in t:
+            kwargs["noise"] = _parse_noise(f"{field}.noise", t["noise"])
         try:
             sensors.append(SensorSpec(name, (x, y), **kwargs))
             resolve(sensors[-1])  # the chain's own rules (mounted resonance above the band)
@@ -321,6 +325,20 @@ def _parse_sensors(value, plate: Plate) -> tuple:
         if name in names[: i - 1]:
             raise InputError(f"sensors[{i}].name", f"{name!r} is used by an earlier sensor")
     return tuple(sensors)
+
+
+def _parse_noise(field: str, value) -> NoiseSpec:
+    """``noise = RMS`` (white, m/s^2) or a table with NOISE_KEYS (tailbeam.noise)."""
+    table = value if isinstance(value, dict) else {"rms": value}
+    _check_keys(field, table, NOISE_KEYS)
+    kwargs = {k: table[k] for k in ("rms", "background", "seed") if k in table}
+    if "band" in table:
+        kwargs["band_hz"] = table["band"]
+    try:
+        return NoiseSpec(**kwargs)
+    except InputError as err:  # NoiseSpec names its fields noise.<key>
+        inner = err.field[len("noise") :] if table is value else ""
+        raise InputError(field + inner, err.rule) from None
 
 
 # -- writing back ---------------------------------------------------------------------------------
@@ -383,6 +401,10 @@ def scene_to_dict(scene: Scene) -> dict:
             d["bandwidth"] = s.bandwidth_hz
         if s.mounted_resonance_hz is not None:
             d["mounted_resonance"] = s.mounted_resonance_hz
+        if s.noise is not None:
+            n = s.noise
+            d["noise"] = {"rms": n.rms, "background": n.background, "band": list(n.band_hz)}
+            d["noise"]["seed"] = n.seed
         sensors.append(d)
     if sensors:
         out["sensors"] = sensors
@@ -398,6 +420,8 @@ def _toml_value(v) -> str:
         return repr(v) if math.isfinite(v) else ("nan" if v != v else ("inf" if v > 0 else "-inf"))
     if isinstance(v, str):
         return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
     return "[" + ", ".join(_toml_value(x) for x in v) + "]"
 
 

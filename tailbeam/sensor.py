@@ -10,7 +10,8 @@ The chain, per ``tailbeam.scene.SensorSpec``:
    bandwidth and whose stopband starts at fs - bandwidth, so everything that folds back below
    the bandwidth is attenuated >= 90 dB (the delta-sigma DAQ design, "alias-free bandwidth");
    its group delay is compensated, as DAQ software does;
-4. sampling at ``sample_rate`` (decimation of the fine grid).
+4. sampling at ``sample_rate`` (decimation of the fine grid);
+5. measurement noise, if the spec has any (``tailbeam.noise``), added to the samples.
 
 Defaults (docs/coupled-and-sensors.md, "Sensor chain"): sample rate 51.2 kHz; bandwidth
 fs/2.56 = 20 kHz, the classic
@@ -28,6 +29,7 @@ from scipy import fft as sp_fft
 from scipy import signal
 
 from tailbeam.errors import InputError
+from tailbeam.noise import noise
 from tailbeam.scene import SensorSpec
 
 BANDWIDTH_FRACTION = 1.0 / 2.56  # of the sample rate
@@ -150,6 +152,8 @@ def measure(
     a_true = np.asarray(true_acceleration(t_fine), dtype=float)
     y = _apply_resonance(chain, a_true)
     y = signal.lfilter(taps, [1.0], y)[delay :: chain.oversample][:n_out]
+    if spec.noise is not None:
+        y = y + noise(spec.noise, spec.name, n_out, chain.sample_rate)
     t = np.arange(n_out) / chain.sample_rate
     freq, amp = amplitude_spectrum(y, chain.sample_rate)
     return SensorOutput(spec.name, t, y, freq, amp, chain)

@@ -1,0 +1,188 @@
+"""Benchmark of `tailbeam sweep`: throughput on 1 and 2 Dask workers beside a plain loop,
+the share of dataset writing, and worker memory.
+
+    python benchmarks/bench_sweep.py [--out DIR] [--quick] [--cases N]
+
+The sweep: N single impacts (default 200; half coal, half sandstone; radius log-uniform
+10-100 mm, 1-5 m/s, anywhere over |x|, |y| <= 0.25 m) on the SSSS modal plate (modes to 5 kHz,
+basis cached before timing), one sensor at 12.8 kHz, 25 ms each. Runs, on the same cases:
+1. baseline: the cases in a plain loop in this process (run_case, no Dask, no writing);
+2. the sweep on a LocalCluster of 1 worker, then of 2 workers (fresh dataset folder each;
+   workers started and warmed before the clock starts).
+Reports cases/s, speed-up over 1 worker, time spent writing the dataset (Zarr + Parquet + CSV)
+as a share of the summed case compute time, and each worker's peak resident memory. Writes
+DIR/bench_sweep.csv and DIR/table.md. Timings on a shared machine are noisy.
+"""
+
+import argparse
+import csv
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from tailbeam.study.case import run_case, warm_basis
+from tailbeam.study.design import expand, parse_sweep
+from tailbeam.study.sweep import close_client, connect, run_sweep
+
+
+def sweep_spec(n_cases: int):
+    per_class = max(1, n_cases // 2)
+
+    def dist(lo, hi, kind="uniform"):
+        return {"distribution": kind, "low": lo, "high": hi, "samples": per_class}
+
+    scene = {
+        "duration": 0.025,
+        "plate": {"model": "modal", "boundary": "SSSS", "fmax": 5000.0},
+        "balls": [
+            {
+                "name": "rock",
+                "material": "coal",
+                "radius": 0.03,
+                "position": [0.0, 0.0, 0.0302],
+                "velocity": [0.0, 0.0, -2.0],
+            }
+        ],
+        "sensors": [{"name": "S1", "position": [0.1, 0.15], "sample_rate": 12800.0}],
+    }
+    return parse_sweep(
+        {
+            "scene": scene,
+            "seed": 11,
+            "axes": {
+                "balls.rock.material": ["coal", "sandstone"],
+                "balls.rock.radius": dist(0.01, 0.1, "loguniform"),
+                "balls.rock.position[2]": {"follow": "balls.rock.radius", "offset": 0.0002},
+                "balls.rock.velocity[2]": dist(-5.0, -1.0),
+                "balls.rock.position[0]": dist(-0.25, 0.25),
+                "balls.rock.position[1]": dist(-0.25, 0.25),
+            },
+        }
+    )
+
+
+def _peak_rss_mb() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
+
+
+def baseline(cases, coal) -> dict:
+    t0 = time.perf_counter()
+    for c in cases:
+        run_case(c.toml, coal)
+    wall = time.perf_counter() - t0
+    return {"run": "plain loop (no Dask)", "workers": 1, "wall_s": wall, "cases": len(cases)}
+
+
+def dask_run(spec, n_workers: int, out: Path) -> dict:
+    client = connect(workers=n_workers)
+    try:
+        # warm every worker: imports, numba cache, basis cache (not timed)
+        first = expand(spec)[0]
+        client.run(warm_basis, first.toml)
+        client.run(run_case, first.toml, spec.coal)
+        t0 = time.perf_counter()
+        summary = run_sweep(spec, out, client=client)
+        wall = time.perf_counter() - t0
+        rss = client.run(_peak_rss_mb)
+        limit = client.run(lambda dask_worker: dask_worker.memory_manager.memory_limit)
+    finally:
+        close_client(client)
+    ledger = pd.read_csv(out / "cases.csv")
+    compute = float(ledger["wall_time"].sum())
+    cpu = float(ledger["cpu_time"].sum())
+    return {
+        "run": f"sweep, LocalCluster {n_workers} worker(s)",
+        "workers": n_workers,
+        "wall_s": wall,
+        "cases": summary["ok"] + summary["failed"],
+        "failed": summary["failed"],
+        "compute_s": compute,
+        "cpu_s": cpu,
+        "write_s": summary["write_time_s"],
+        "write_share_of_compute": summary["write_time_s"] / compute,
+        "peak_worker_rss_mb": max(rss.values()),
+        "worker_memory_limit_mb": max(limit.values()) / 2**20,
+    }
+
+
+def main(out_dir="out/benchmarks/bench_sweep", quick: bool = False, n_cases: int | None = None):
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    n = n_cases or (20 if quick else 200)
+    spec = sweep_spec(n)
+    cases = expand(spec)
+    warm_basis(cases[0].toml)
+    run_case(cases[0].toml, spec.coal)  # compile/load numba here too
+    rows = [baseline(cases, spec.coal)]
+    for w in (1, 2):
+        target = out_dir / f"dataset_{w}w"
+        if target.exists():
+            import shutil
+
+            shutil.rmtree(target)
+        rows.append(dask_run(spec, w, target))
+    for r in rows:
+        r["cases_per_s"] = r["cases"] / r["wall_s"]
+        if "compute_s" in r:
+            # time the workers spent inside cases / the time they had: Dask's overhead shows
+            # here; a longer mean case time at more workers shows competition for the cores
+            r["mean_case_s"] = r["compute_s"] / r["cases"]
+            r["worker_occupancy"] = r["compute_s"] / (r["workers"] * r["wall_s"])
+            # share of a case's wall time its worker had a core: < 1 when cores are contended
+            r["cpu_share"] = r["cpu_s"] / r["compute_s"]
+            # throughput if every worker had its own core (an estimate, not a measurement)
+            r["cases_per_s_own_cores"] = (
+                r["workers"] * r["worker_occupancy"] / (r["cpu_s"] / r["cases"])
+            )
+    one = next(r for r in rows if r["workers"] == 1 and "sweep" in r["run"])
+    for r in rows:
+        r["speedup_vs_1_worker"] = r["cases_per_s"] / one["cases_per_s"]
+    keys = sorted({k for r in rows for k in r}, key=list(rows[-1]).index)
+    with (out_dir / "bench_sweep.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=keys)
+        w.writeheader()
+        w.writerows(rows)
+    _table(rows, out_dir / "table.md", n)
+    return rows
+
+
+def _table(rows, path: Path, n: int) -> None:
+    cores = len(os.sched_getaffinity(0))
+    lines = [
+        f"{n} single-impact cases (modal plate, cached basis), {cores} cores, load average "
+        f"{os.getloadavg()[0]:.1f} at the end (a shared machine: other work competes).",
+        "",
+        "| run | cases/s | speed-up vs 1 worker | mean case time (s) | CPU share of case time "
+        "| worker occupancy | cases/s if each worker had a core (estimate) | writing / compute "
+        "| peak worker RSS (MB) | worker memory limit (MB) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        share = f"{r['write_share_of_compute']:.1%}" if "write_s" in r else "-"
+        rss = f"{r['peak_worker_rss_mb']:.0f}" if "peak_worker_rss_mb" in r else "-"
+        lim = f"{r['worker_memory_limit_mb']:.0f}" if "worker_memory_limit_mb" in r else "-"
+        case = f"{r['mean_case_s']:.3f}" if "mean_case_s" in r else "-"
+        occ = f"{r['worker_occupancy']:.0%}" if "worker_occupancy" in r else "-"
+        cpu = f"{r['cpu_share']:.0%}" if "cpu_share" in r else "-"
+        own = f"{r['cases_per_s_own_cores']:.2f}" if "cpu_share" in r else "-"
+        lines.append(
+            f"| {r['run']} | {r['cases_per_s']:.2f} | {r['speedup_vs_1_worker']:.2f} | {case} "
+            f"| {cpu} | {occ} | {own} | {share} | {rss} | {lim} |"
+        )
+    path.write_text("\n".join(lines) + "\n")
+    print(path.read_text())
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default="out/benchmarks/bench_sweep")
+    parser.add_argument("--quick", action="store_true", help="20 cases")
+    parser.add_argument("--cases", type=int, default=None)
+    args = parser.parse_args()
+    np.seterr(all="ignore")
+    main(args.out, quick=args.quick, n_cases=args.cases)

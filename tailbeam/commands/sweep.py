@@ -1,0 +1,41 @@
+"""`tailbeam sweep SWEEP.toml --out DIR [--workers N | --scheduler ADDRESS]`: run a parameter
+sweep on Dask and write a labelled dataset (tailbeam.study; needs ``tailbeam[study]``).
+
+The sweep file and every case's scene are validated before any work (one-line errors, exit
+code 2). Writes DIR/dataset.zarr, DIR/impacts.parquet and DIR/cases.csv; running it again
+skips finished cases and retries failed ones.
+"""
+
+from tailbeam.errors import InputError
+
+
+def add_arguments(parser):
+    parser.add_argument("sweep", help="sweep file (TOML): scene, [axes], repeats, seed")
+    parser.add_argument("--out", default="out/sweep", help="dataset folder (default out/sweep)")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers", type=int, default=None, help="local Dask worker processes (default: cores)"
+    )
+    where.add_argument(
+        "--scheduler", default=None, help="address of a running Dask scheduler (tcp://host:port)"
+    )
+
+
+def run(args) -> int:
+    from tailbeam.study import require_study_dependencies
+
+    require_study_dependencies()
+    if args.workers is not None and args.workers < 1:
+        raise InputError("--workers", f"must be a whole number >= 1, got {args.workers}")
+    from tailbeam.study.design import expand, load_sweep
+    from tailbeam.study.sweep import run_sweep
+
+    spec = load_sweep(args.sweep)
+    expand(spec)  # every case's scene validated before a worker starts
+    s = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler)
+    ran = s["ok"] + s["failed"]
+    print(
+        f"{args.sweep}: {s['cases']} cases, {s['skipped']} already done, {ran} run "
+        f"({s['ok']} ok, {s['failed']} failed); dataset in {args.out}"
+    )
+    return 1 if s["failed"] else 0

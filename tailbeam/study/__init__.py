@@ -1,0 +1,29 @@
+"""Labelled vibration datasets and how separable coal and gangue are (``tailbeam[study]``).
+
+- ``design``: the sweep file (base scene, axes, repeats) and its expansion into cases;
+- ``case``: one case, run on a Dask worker (labels, signals, impacts);
+- ``sweep``: running the cases on Dask (local cluster or a scheduler), resumable;
+- ``dataset``: the on-disk dataset (dataset.zarr, impacts.parquet, cases.csv);
+- ``features``: signal features per window (pure numpy/scipy/PyWavelets functions);
+- ``windows``: impact windows and fixed windows cut from the dataset, and the feature table;
+- ``learn``: scikit-learn baselines with cross-validation grouped by case.
+
+The optional dependencies (dask, xarray, zarr, pyarrow, scikit-learn, PyWavelets) are imported
+inside the functions that need them, so ``import tailbeam`` stays light.
+"""
+
+STUDY_MODULES = ("dask.distributed", "xarray", "zarr", "pyarrow", "sklearn", "pywt", "pandas")
+
+
+def require_study_dependencies() -> None:
+    """Raise InputError naming the install command when an optional dependency is missing."""
+    import importlib.util
+
+    from tailbeam.errors import InputError
+
+    missing = [m for m in STUDY_MODULES if importlib.util.find_spec(m.split(".")[0]) is None]
+    if missing:
+        raise InputError(
+            "dependencies",
+            f"{', '.join(missing)} not installed; install them with pip install 'tailbeam[study]'",
+        )

@@ -1,0 +1,256 @@
+"""The dataset of a sweep, in its output folder DIR:
+
+- ``dataset.zarr``: an xarray Dataset (Zarr v3). ``acceleration`` (case, sensor, time) float32
+  in m/s^2 as each sensor recorded it (chain and noise included); coordinates of ``case``: the
+  case hash, seed, repeat, labels (``label``, ``gangue_fraction``, ``n_coal``, ``n_gangue``,
+  ``n_coal_impacts``, ``n_gangue_impacts``) and every swept value (vector values one
+  coordinate per component, ``key[i]``); ``sensor_x``, ``sensor_y`` (case, sensor) in m.
+  Attributes: units, sample rate (Hz), duration (s), the base sensor positions, the tailbeam
+  version, the sweep file, and ``case_scenes`` (case hash -> the case's scene TOML).
+  Finished cases are appended along ``case``; open it with ``xarray.open_zarr(DIR/dataset.zarr)``.
+- ``impacts.parquet``: one row per impact of every finished case (``case``, ``case_hash``, the
+  impacts.csv columns, the ball's ``material`` and ``class``).
+- ``cases.csv``: one row per case run so far: ``case``, ``case_hash``, ``status`` (ok | failed),
+  ``error`` (one line), ``wall_time`` and ``cpu_time`` (s, on the worker), seed, repeat,
+  labels and the swept values.
+
+Order of writes per batch: impacts.parquet (whole table, atomic rename), then the Zarr append,
+then cases.csv. The Zarr store is the record of finished cases: on opening, impact rows of
+cases missing from it (a crash mid-batch) are dropped and cases.csv is completed from it.
+"""
+
+import json
+import os
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from tailbeam import __version__
+
+LABEL_COLUMNS = (
+    "label",
+    "gangue_fraction",
+    "n_coal",
+    "n_gangue",
+    "n_coal_impacts",
+    "n_gangue_impacts",
+)
+LEDGER_COLUMNS = (
+    "case",
+    "case_hash",
+    "status",
+    "error",
+    "wall_time",
+    "cpu_time",
+    "seed",
+    "repeat",
+)
+CHUNK_BYTES = 4 << 20  # target size of one Zarr chunk of signals along case
+CASE_COORD_CHUNK = 4096  # cases per chunk of the per-case coordinates
+
+
+def flat_params(params: dict) -> dict:
+    """Swept values as scalars: a vector value ``key`` becomes ``key[0]``, ``key[1]``, ..."""
+    out = {}
+    for key, value in params.items():
+        if isinstance(value, list | tuple):
+            out.update({f"{key}[{i}]": v for i, v in enumerate(value)})
+        else:
+            out[key] = value
+    return out
+
+
+def _atomic_write(path: Path, write) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+class DatasetStore:
+    """The dataset files of one output folder: what is done, and appending finished cases."""
+
+    def __init__(self, out_dir, sweep_text: str = ""):
+        import pandas as pd
+
+        self.dir = Path(out_dir)  # created by the first record()
+        self.zarr_path = self.dir / "dataset.zarr"
+        self.sweep_text = sweep_text
+        csv = self.dir / "cases.csv"
+        self.ledger = pd.read_csv(csv) if csv.is_file() else pd.DataFrame(columns=LEDGER_COLUMNS)
+        self.impacts = (
+            pd.read_parquet(self.dir / "impacts.parquet")
+            if (self.dir / "impacts.parquet").is_file()
+            else None
+        )
+        self._reconcile()
+
+    # -- state ------------------------------------------------------------------------------------
+
+    def stored_hashes(self) -> set:
+        """Hashes of the cases in dataset.zarr."""
+        if not self.zarr_path.exists():
+            return set()
+        import xarray as xr
+
+        with xr.open_zarr(self.zarr_path) as ds:
+            return {str(h) for h in ds["case_hash"].values}
+
+    def _reconcile(self) -> None:
+        import xarray as xr
+
+        stored = self.stored_hashes()
+        if self.impacts is not None:
+            self.impacts = self.impacts[self.impacts["case_hash"].isin(stored)]
+        known = set(self.ledger.loc[self.ledger["status"] == "ok", "case_hash"])
+        missing = stored - known
+        if missing:  # finished cases whose ledger row was not written: rebuild from the store
+            with xr.open_zarr(self.zarr_path) as ds:
+                coords = ds.drop_vars(["acceleration", "sensor", "time", "sensor_x", "sensor_y"])
+                df = coords.to_dataframe().reset_index()
+            df = df[df["case_hash"].isin(missing)].assign(status="ok", error="")
+            self._set_rows(df.to_dict("records"))
+
+    def done(self) -> set:
+        """Hashes of finished cases (status ok and stored)."""
+        ok = set(self.ledger.loc[self.ledger["status"] == "ok", "case_hash"])
+        return ok & self.stored_hashes() if ok else set()
+
+    def case_ids(self, hashes: list) -> list:
+        """Integer ids of cases: kept from their first record, else the next free ones."""
+        known = dict(zip(self.ledger["case_hash"], self.ledger["case"], strict=True))
+        nxt = int(self.ledger["case"].max()) + 1 if len(self.ledger) else 0
+        out = []
+        for h in hashes:
+            if h not in known:
+                known[h] = nxt
+                nxt += 1
+            out.append(int(known[h]))
+        return out
+
+    def _set_rows(self, rows: list) -> None:
+        import pandas as pd
+
+        new = pd.DataFrame(rows)
+        keep = self.ledger[~self.ledger["case_hash"].isin(new["case_hash"])]
+        frames = [f for f in (keep, new) if len(f)]
+        self.ledger = pd.concat(frames, ignore_index=True) if frames else new
+        self.ledger = self.ledger.sort_values("case", kind="stable").reset_index(drop=True)
+
+    # -- writing ----------------------------------------------------------------------------------
+
+    def record(self, batch: list) -> None:
+        """Write a batch of (Case, result dict, Scene) of finished or failed cases."""
+        self.dir.mkdir(parents=True, exist_ok=True)
+        rows, ok = [], []
+        ids = self.case_ids([case.hash for case, _r, _s in batch])
+        for (case, result, scene), cid in zip(batch, ids, strict=True):
+            row = {
+                "case": cid,
+                "case_hash": case.hash,
+                "status": result["status"],
+                "error": result["error"],
+                "wall_time": result["wall_time"],
+                "cpu_time": result.get("cpu_time", float("nan")),
+                "seed": case.seed,
+                "repeat": case.repeat,
+                **case.labels,
+                "n_coal_impacts": result["n_coal_impacts"],
+                "n_gangue_impacts": result["n_gangue_impacts"],
+                **flat_params(case.params),
+            }
+            rows.append(row)
+            if result["status"] == "ok":
+                ok.append((row, case, result, scene))
+        if ok:
+            self._write_impacts(ok)
+            self._append_zarr(ok)
+        self._set_rows(rows)
+        _atomic_write(self.dir / "cases.csv", lambda p: self.ledger.to_csv(p, index=False))
+
+    def _write_impacts(self, ok: list) -> None:
+        import pandas as pd
+
+        frames = [self.impacts] if self.impacts is not None else []
+        for row, case, result, _scene in ok:
+            df = pd.DataFrame(result["impacts"])
+            if len(df):
+                frames.append(df.assign(case=row["case"], case_hash=case.hash))
+        frames = [f for f in frames if len(f)]
+        if not frames:
+            return
+        table = pd.concat(frames, ignore_index=True)
+        cols = ["case", "case_hash"] + [c for c in table.columns if c not in ("case", "case_hash")]
+        self.impacts = table[cols]
+        _atomic_write(self.dir / "impacts.parquet", lambda p: self.impacts.to_parquet(p))
+
+    def _append_zarr(self, ok: list) -> None:
+        import zarr
+
+        ds = self._batch_dataset(ok)
+        existing = self.zarr_path.exists()
+        scenes = {case.hash: case.toml for _r, case, _res, _s in ok}
+        if existing:
+            scenes = {**zarr.open_group(self.zarr_path, mode="r").attrs["case_scenes"], **scenes}
+        ds.attrs["case_scenes"] = scenes
+        with warnings.catch_warnings():
+            # consolidated metadata is not in the Zarr v3 spec yet; xarray reads it, and
+            # without it every xarray.open_zarr warns
+            warnings.filterwarnings("ignore", message="Consolidated metadata")
+            if existing:
+                ds.to_zarr(self.zarr_path, append_dim="case", mode="a")
+            else:
+                ds.to_zarr(self.zarr_path, mode="w", encoding=self._encoding(ds))
+
+    def _encoding(self, ds) -> dict:
+        per_case = ds["acceleration"][0].nbytes
+        chunk = max(1, CHUNK_BYTES // max(per_case, 1))
+        n_sensor, n_time = ds["acceleration"].shape[1:]
+        enc = {"acceleration": {"chunks": (chunk, n_sensor, n_time)}}
+        for name, var in ds.coords.items():  # per-case values: few, large chunks
+            if var.dims and var.dims[0] == "case":
+                enc[name] = {"chunks": (CASE_COORD_CHUNK, *var.shape[1:])}
+        return enc
+
+    def _batch_dataset(self, ok: list):
+        import xarray as xr
+
+        first_scene = ok[0][3]
+        names = [s.name for s in first_scene.sensors]
+        fs = first_scene.sensors[0].sample_rate
+        acc = np.stack([np.stack([res["signals"][n] for n in names]) for _r, _c, res, _s in ok])
+        n_time = acc.shape[-1]
+        coords = {
+            "case": ("case", np.array([r["case"] for r, *_ in ok], dtype=np.int64)),
+            "sensor": ("sensor", np.array(names, dtype=object)),
+            "time": ("time", np.arange(n_time) / fs, {"units": "s"}),
+        }
+        skip = ("case", "status", "error", "wall_time", "cpu_time")
+        for col in [c for c in ok[0][0] if c not in skip]:
+            values = np.array([r[col] for r, *_ in ok])
+            coords[col] = ("case", values.astype(object) if values.dtype.kind == "U" else values)
+        for axis, unit in ((0, "sensor_x"), (1, "sensor_y")):
+            pos = [[s.position[axis] for s in sc.sensors] for _r, _c, _res, sc in ok]
+            coords[unit] = (("case", "sensor"), np.array(pos), {"units": "m"})
+        acc_attrs = {"units": "m/s^2", "long_name": "sensor acceleration normal to the plate"}
+        return xr.Dataset(
+            {"acceleration": (("case", "sensor", "time"), acc.astype(np.float32), acc_attrs)},
+            coords=coords,
+            attrs={
+                "title": "tailbeam sweep: simulated tail-beam vibration, labelled",
+                "tailbeam_version": __version__,
+                "sample_rate_hz": fs,
+                "duration_s": first_scene.duration,
+                "units": "acceleration m/s^2, time s, positions m",
+                "sensor_positions_m": json.dumps(
+                    {s.name: list(s.position) for s in first_scene.sensors}
+                ),
+                "sweep_file": self.sweep_text,
+            },
+        )

@@ -1,0 +1,145 @@
+"""`tailbeam sweep` on a real Dask scheduler and workers (separate processes, 127.0.0.1):
+the dataset's signals equal a direct simulation of each case's scene, a failing case is
+recorded and does not stop the sweep, a rerun resumes, a grown sweep appends; the Zarr store
+opens with xarray.open_zarr and each modal basis is computed once."""
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("dask.distributed")
+pytest.importorskip("xarray")
+
+import pandas as pd  # noqa: E402
+import xarray as xr  # noqa: E402
+
+from tailbeam.cli import main  # noqa: E402
+from tailbeam.commands.simulate import solve  # noqa: E402
+from tailbeam.scene_file import loads_scene  # noqa: E402
+
+BASE = """
+duration = 0.01
+[plate]
+model = "modal"
+fmax = 3000.0
+[[balls]]
+name = "rock"
+material = "coal"
+radius = 0.02
+position = [0.05, -0.05, 0.0205]
+velocity = [0.0, 0.0, -2.0]
+[[sensors]]
+name = "S1"
+position = [0.1, 0.1]
+sample_rate = 8000.0
+noise = 0.5
+[[sensors]]
+name = "S2"
+position = [-0.2, 0.05]
+sample_rate = 8000.0
+"""
+
+# plate.fmax = 1 Hz passes the scene check but fails at run time: no mode lies below it
+SWEEP = """
+scene = "base.toml"
+[axes]
+"balls.rock.material" = ["coal", "sandstone"]
+"plate.fmax" = [{fmax}]
+"""
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    from tailbeam.study.sweep import local_cluster
+
+    cluster = local_cluster(2)
+    assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+    yield cluster.scheduler_address
+    cluster.close()
+
+
+def _run(tmp: Path, address: str, fmax: str, capsys):
+    (tmp / "base.toml").write_text(BASE)
+    (tmp / "sweep.toml").write_text(SWEEP.format(fmax=fmax))
+    code = main(
+        ["sweep", str(tmp / "sweep.toml"), "--out", str(tmp / "out"), "--scheduler", address]
+    )
+    return code, capsys.readouterr()
+
+
+def _cache_files():
+    return sorted(Path(os.environ["TAILBEAM_CACHE_DIR"]).glob("modes-*.npz"))
+
+
+def test_sweep_records_failures_resumes_and_appends(tmp_path, scheduler, capsys):
+    before = _cache_files()
+    code, io = _run(tmp_path, scheduler, "1.0, 3000.0", capsys)
+    assert code == 1  # some cases failed
+    assert "4 cases, 0 already done, 4 run (2 ok, 2 failed)" in io.out
+    out = tmp_path / "out"
+    cases = pd.read_csv(out / "cases.csv")
+    assert sorted(cases["status"]) == ["failed", "failed", "ok", "ok"]
+    failed = cases[cases["status"] == "failed"]
+    assert (failed["plate.fmax"] == 1.0).all()
+    assert failed["error"].str.contains("no mode lies below 1.0 Hz").all()
+    assert len(_cache_files()) == len(before) + 1  # one basis (3 kHz) for both good cases
+
+    ds = xr.open_zarr(out / "dataset.zarr")
+    assert ds["acceleration"].dims == ("case", "sensor", "time")
+    assert ds["acceleration"].dtype == np.float32
+    assert ds["acceleration"].attrs["units"] == "m/s^2"
+    assert ds.attrs["sample_rate_hz"] == 8000.0
+    assert list(ds["sensor"].values) == ["S1", "S2"]
+    assert sorted(ds["label"].values) == ["coal", "gangue"]
+    assert set(ds["gangue_fraction"].values) == {0.0, 1.0}
+    np.testing.assert_allclose(ds["sensor_x"].values, [[0.1, -0.2], [0.1, -0.2]])
+    impacts = pd.read_parquet(out / "impacts.parquet")
+    assert set(impacts["case"]) == set(ds["case"].values)
+    for cid in ds["case"].values:
+        one = ds.sel(case=cid)
+        toml = ds.attrs["case_scenes"][str(one["case_hash"].values)]
+        direct = solve(loads_scene(toml))  # the case simulated here, outside Dask
+        for k, name in enumerate(["S1", "S2"]):
+            expected = direct.sensor_signals[name][1].astype(np.float32)
+            np.testing.assert_array_equal(one["acceleration"].values[k], expected)
+        rows = impacts[impacts["case"] == cid]
+        assert (
+            len(rows) == len(direct.impacts) == int(one["n_coal_impacts"] + one["n_gangue_impacts"])
+        )
+        np.testing.assert_allclose(rows["v_in"], [i.v_in for i in direct.impacts])
+    ids = dict(zip(cases["case_hash"], cases["case"], strict=True))
+
+    # rerun: the finished cases are skipped, the failed ones retried (and fail again)
+    code, io = _run(tmp_path, scheduler, "1.0, 3000.0", capsys)
+    assert "4 cases, 2 already done, 2 run (0 ok, 2 failed)" in io.out
+    assert xr.open_zarr(out / "dataset.zarr").sizes["case"] == 2
+
+    # grown sweep without the failing value: only the new cases run, appended, ids kept
+    code, io = _run(tmp_path, scheduler, "3000.0, 2500.0", capsys)
+    assert code == 0 and "4 cases, 2 already done, 2 run (2 ok, 0 failed)" in io.out
+    ds = xr.open_zarr(out / "dataset.zarr")
+    assert ds.sizes["case"] == 4 and len(set(ds["case"].values)) == 4
+    cases = pd.read_csv(out / "cases.csv")
+    assert all(
+        ids[h] == c for h, c in zip(cases["case_hash"], cases["case"], strict=True) if h in ids
+    )
+    assert len(ds.attrs["case_scenes"]) == 4
+    assert sorted(pd.read_parquet(out / "impacts.parquet")["case"].unique()) == sorted(
+        ds["case"].values
+    )
+
+
+def test_progress_lines_show_failures(monkeypatch, capsys):
+    from tailbeam import progress
+
+    monkeypatch.setattr(progress, "DELAY_S", 0.0)
+    with progress.task("sweep of 3 cases", total=3, unit="cases") as bar:
+        bar.update(1)
+        bar.set_postfix("1 failed")
+        bar.update(2)
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines[0].startswith("tailbeam: sweep of 3 cases: 1/3 cases, ")
+    assert "left" in lines[0]  # time left
+    assert lines[-1].startswith("tailbeam: sweep of 3 cases: 3/3 cases (1 failed), ")
