@@ -150,3 +150,21 @@ def test_core_imports_and_cli_work_without_the_study_extra():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 2, done.stderr
     assert "pip install 'tailbeam[study]'" in done.stderr
+
+
+def test_example_sweep_file_expands_to_its_stated_cases():
+    """examples/sweep_single_impacts.toml (the README's example) says 2 x 20 = 40 cases; every
+    radius lies in its log-uniform range and the drop gap follows the radius."""
+    from pathlib import Path
+
+    from tailbeam.study.design import load_sweep
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "sweep_single_impacts.toml"
+    cases = expand(load_sweep(path))
+    assert len(cases) == 40
+    materials = sorted(c.params["balls.rock.material"] for c in cases)
+    assert materials == ["coal"] * 20 + ["sandstone"] * 20
+    for c in cases:
+        r = c.params["balls.rock.radius"]
+        assert 0.01 <= r <= 0.1
+        assert c.params["balls.rock.position[2]"] == pytest.approx(r + 0.0002, rel=1e-12)
