@@ -143,8 +143,9 @@ class CoupledResult:
 
     def quasi_static_sample(self, times, points) -> dict:
         """The truncated modes' quasi-static (mode-acceleration) response at points (p, 2) m:
-        w = -G_res F(t) (F pushes the plate down), with G_res the residual cross compliance between the ball's contact and
-        each point (ModalBasis.residual_cross_compliance, the same load model as the contact).
+        w = -G_res F(t) (F pushes the plate down), G_res the residual cross compliance between
+        the ball's contact and each point (ModalBasis.residual_cross_compliance, with the
+        contact's load model).
         v and a are its central differences over +-h: h is the spacing of uniform ``times``
         (so a sampled record is the exact second difference of the sampled force: gain
         sinc^2(f h), no aliasing of the force's kinks), else 1/(8 f_top). Arrays (p, len)."""
