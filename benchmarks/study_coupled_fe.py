@@ -148,6 +148,7 @@ def plot(rows, out: Path):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     theories = sorted({r[0] for r in rows})
     fig, axes = plt.subplots(len(theories), 2, figsize=(10, 3.8 * len(theories)), squeeze=False)
@@ -172,6 +173,7 @@ def plot(rows, out: Path):
             ax.set_ylabel("relative error vs full FE")
             ax.set_title(f"{theory}: {what}", fontsize=10)
             ax.set_xticks([10, 14, 20, 28, 40], labels=["10", "14", "20", "28", "40"])
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=7)
     fig.tight_layout()
@@ -186,9 +188,16 @@ def main(argv=None):
     ap.add_argument("--theory", choices=("kirchhoff", "mindlin", "both"), default="both")
     ap.add_argument("--dt", type=float, default=1e-7, help="reference step, s")
     ap.add_argument("--steps", type=int, default=800, help="modal steps per contact")
+    ap.add_argument("--replot", action="store_true", help="redraw study.png from study.csv")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.replot:
+        with open(out / "study.csv") as fh:
+            rows = [(r[0], float(r[1]), int(r[2]), r[3], float(r[4]), float(r[5]))
+                    for r in list(csv.reader(fh))[1:]]  # fmt: skip
+        plot(rows, out)
+        return rows
     theories = ("kirchhoff", "mindlin") if args.theory == "both" else (args.theory,)
     rows, meta = [], []
     for theory in theories:
