@@ -3,10 +3,21 @@
 What to simulate is positional, how to simulate is keyword-only. SI units throughout.
 """
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ImpactLaw, ball_ball_law, ball_plate_law, impact_force, step
-from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE, Material, get_material
+from tailbeam.cachedir import configure_numba_cache
+
+configure_numba_cache()  # before any module defines a cached numba kernel
+
+# the imports below come after the cache is configured
+from tailbeam.bodies import Ball, Plate  # noqa: E402
+from tailbeam.contact_law import (  # noqa: E402
+    ImpactLaw,
+    ball_ball_law,
+    ball_plate_law,
+    impact_force,
+    step,
+)
+from tailbeam.errors import InputError, WorkLimitError  # noqa: E402
+from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE, Material, get_material  # noqa: E402
 
 __all__ = [
     "Ball",

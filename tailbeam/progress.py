@@ -51,12 +51,18 @@ class _LogBar:
         elapsed = time.monotonic() - self.start
         done = f"{self.n:g}" + (f"/{self.total:g}" if self.total else "")
         unit = f" {self.unit}" if self.unit else ""
+        if not self.total and not self.n:  # nothing counted: elapsed time only
+            done = unit = ""
+        else:
+            unit += ","
         tail = "done" if final else "..."
         eta = ""
         if not final and self.total and 0 < self.n < self.total:
             eta = f", ~{elapsed * (self.total - self.n) / self.n:.0f} s left"
         print(
-            f"tailbeam: {self.description}: {done}{unit}, {elapsed:.1f} s{eta} {tail}",
+            f"tailbeam: {self.description}: {done}{unit} {elapsed:.1f} s{eta} {tail}".replace(
+                ":  ", ": "
+            ),
             file=sys.stderr,
             flush=True,
         )

@@ -59,10 +59,11 @@ def write_csv(path, header, rows) -> Path:
 
 
 def write_impacts_csv(path, impacts) -> Path:
-    """One row per contact, columns IMPACT_COLUMNS."""
-    return write_csv(
-        path, IMPACT_COLUMNS, ([getattr(i, c) for c in IMPACT_COLUMNS] for i in impacts)
-    )
+    """One row per contact, columns IMPACT_COLUMNS (units in the manifest)."""
+    from tailbeam.output import describe
+
+    write_csv(path, IMPACT_COLUMNS, ([getattr(i, c) for c in IMPACT_COLUMNS] for i in impacts))
+    return describe(path, units=IMPACT_UNITS)
 
 
 def _jsonable(value):
@@ -104,13 +105,23 @@ def result_summary(result, scene_echo: dict | None = None) -> dict:
     return out
 
 
+def uniform_grid(duration: float, sample_rate: float) -> np.ndarray:
+    """Times k / sample_rate (s) for k = 0, 1, ... up to ``duration`` (s) inclusive."""
+    n = int(math.floor(duration * sample_rate * (1.0 + 1e-12))) + 1
+    t = np.arange(n, dtype=float) / sample_rate
+    return t[t <= duration]
+
+
+TIMESERIES_UNITS = {"t": "s", "z": "m", "vz": "m/s", "force": "N"}
+
+
 def timeseries(result, sample_rate: float):
     """(header, columns) of the time series: t, then z_, vz_, force_ per ball.
 
-    Sampled on ``result.time_grid(sample_rate)``: the uniform grid plus every impact's peak
-    time, so each force peak is in the file.
+    On the uniform grid k / sample_rate, so an FFT of a column is valid; the exact force
+    peaks are in impacts.csv (peak_force, t_peak), not in this file.
     """
-    t = result.time_grid(sample_rate)
+    t = uniform_grid(result.duration, sample_rate)
     states = result.sample(t)
     header, cols = ["t"], [t]
     for name, s in states.items():
@@ -120,8 +131,13 @@ def timeseries(result, sample_rate: float):
 
 
 def write_timeseries_csv(path, result, sample_rate: float) -> Path:
+    """timeseries.csv on the uniform grid; its units and sample rate go to the manifest."""
+    from tailbeam.output import describe
+
     header, cols = timeseries(result, sample_rate)
-    return write_csv(path, header, zip(*(np.asarray(c, dtype=float) for c in cols), strict=True))
+    write_csv(path, header, zip(*(np.asarray(c, dtype=float) for c in cols), strict=True))
+    units = {h: TIMESERIES_UNITS[h.split("_", 1)[0]] for h in header}
+    return describe(path, sample_rate_hz=sample_rate, grid="uniform", units=units)
 
 
 def write_sensors_csv(path, sensor_signals: dict) -> Path:

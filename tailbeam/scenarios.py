@@ -4,8 +4,8 @@ Every scenario uses Table 1 materials, radius R = 0.03 m and the rigid 0.6 x 0.6
 carbon-steel plate. The balls sit at x = -0.15 m and x = +0.15 m (0.3 m apart, so they never
 touch), start with their lowest point ``DROP_GAP`` above the plate and move straight down at the
 paper's speed. Where the paper is silent (drop gap, duration, c, d) the values come from the
-calibration against every qualitative claim (tailbeam.claims, benchmarks/claim_map.py; README,
-"Defaults").
+calibration against every qualitative claim (tailbeam.claims, benchmarks/claim_map.py;
+docs/reproduction.md, "Defaults").
 """
 
 import math
@@ -28,7 +28,8 @@ DROP_GAP = 0.005
 
 # Simulated time, s, per scenario. 4.1 and 4.2: 1 s shows 4-9 collisions per ball (the claims
 # compare the balls collision by collision); over 5-20 s the near-rest hops and the balls coming
-# to rest overturn the "collides more often" and "short contact" claims (README, "Defaults").
+# to rest overturn the "collides more often" and "short contact" claims
+# (docs/reproduction.md, "Defaults").
 # 4.3: 10 s, because the claim "coal comes to rest first" needs coal declared at rest
 # (tailbeam.rigid's definition: a rebound slower than its rest_speed, 0.01 m/s); with the STEP
 # ramp the damping vanishes at small penetration, so the last bounces are nearly elastic and

@@ -5,7 +5,7 @@ Reading scene files lives in ``tailbeam.scene_file``; this module holds no I/O.
 
 from dataclasses import dataclass, field
 
-from tailbeam.bodies import Ball, Plate
+from tailbeam.bodies import STANDARD_GRAVITY, Ball, Plate
 from tailbeam.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
 from tailbeam.errors import (
     InputError,
@@ -15,15 +15,15 @@ from tailbeam.errors import (
 )
 from tailbeam.materials import Material
 
-# Defaults where the paper is silent (README, "Defaults"). d = 0.1 mm is Adams' default penetration
-# depth. c = 300 N s/m was chosen by running the paper's three scenarios over a grid of (c, d,
-# drop gap) and keeping every qualitative claim of sections 4.1-4.3 and conclusions 1-3 true
-# (tailbeam.claims, benchmarks/claim_map.py): with d = 0.1 mm all claims hold on the grid for
-# c = 300-350 N s/m at every drop gap 0-10 mm, and c = 300 is the one grid value that also holds at
-# 20 mm. The binding claim is 4.3 (coal rebounds above sandstone after collisions 1-2 and below
-# from the 3rd), which needs e_sand / e_coal of about 1.1. At ~1 m/s c = 300 gives restitution
-# 0.84 (coal) and 0.92 (sandstone) on steel; Adams' own default, c = 10 N s/mm, makes coal nearly
-# plastic (e ~ 0.1) and breaks 4.3 and 4.1.
+# Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams'
+# default penetration depth. c = 300 N s/m was chosen by running the paper's three scenarios over
+# a grid of (c, d, drop gap) and keeping every qualitative claim of sections 4.1-4.3 and
+# conclusions 1-3 true (tailbeam.claims, benchmarks/claim_map.py): with d = 0.1 mm all claims hold
+# on the grid for c = 300-350 N s/m at every drop gap 0-10 mm, and c = 300 is the one grid value
+# that also holds at 20 mm. The binding claim is 4.3 (coal rebounds above sandstone after
+# collisions 1-2 and below from the 3rd), which needs e_sand / e_coal of about 1.1. At ~1 m/s c =
+# 300 gives restitution 0.84 (coal) and 0.92 (sandstone) on steel; Adams' own default, c = 10 N
+# s/mm, makes coal nearly plastic (e ~ 0.1) and breaks 4.3 and 4.1.
 DEFAULT_DAMPING = 300.0  # c, N s/m
 DEFAULT_PENETRATION = 1e-4  # d, m (Adams' default 0.1 mm)
 
@@ -146,7 +146,8 @@ class SensorSpec:
 
 @dataclass(frozen=True)
 class Scene:
-    """Everything that defines one simulation. duration in s, sample_rate (output) in Hz."""
+    """Everything that defines one simulation. duration in s, sample_rate (output) in Hz,
+    gravity in m/s^2 (along -z; 0 for none)."""
 
     balls: tuple[Ball, ...]
     plate: Plate = field(default_factory=Plate)
@@ -156,10 +157,12 @@ class Scene:
     plate_model: str = "rigid"
     modal: ModalPlateSettings | None = None
     sensors: tuple[SensorSpec, ...] = ()
+    gravity: float = STANDARD_GRAVITY
 
     def __post_init__(self):
         require_positive("duration", self.duration)
         require_positive("sample_rate", self.sample_rate)
+        object.__setattr__(self, "gravity", require_nonnegative("gravity", self.gravity))
         if self.plate_model not in PLATE_MODELS:
             raise InputError(
                 "plate.model", f"must be one of {PLATE_MODELS}, got {self.plate_model!r}"

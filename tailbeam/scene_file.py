@@ -1,6 +1,6 @@
 """Scene files (TOML): read, validate and write back.
 
-The keys are a contract with users (README, "Scene files"): they may be extended, never renamed.
+The keys are a contract with users (docs/scene-files.md): they may be extended, never renamed.
 Every problem becomes ``InputError(field, rule)`` naming the offending key (``balls[2].radius``,
 balls counted from 1) and the rule; misspelled keys get the closest valid key as a suggestion.
 Omitted optional keys take the defaults of ``tailbeam.scene``.
@@ -8,12 +8,20 @@ Omitted optional keys take the defaults of ``tailbeam.scene``.
 
 import difflib
 import math
+import re
 import sys
 from pathlib import Path
 
 from tailbeam.bodies import Ball, Plate, check_ball_above_plate
-from tailbeam.errors import InputError, require_positive, require_real, require_vector
+from tailbeam.errors import (
+    InputError,
+    require_nonnegative,
+    require_positive,
+    require_real,
+    require_vector,
+)
 from tailbeam.materials import BUILTIN_MATERIALS, Material, get_material
+from tailbeam.preflight import check_scene
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene, SensorSpec
 
 if sys.version_info >= (3, 11):
@@ -21,7 +29,17 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-TOP_KEYS = ("duration", "sample_rate", "contact", "plate", "materials", "balls", "sensors")
+TOP_KEYS = (
+    "duration",
+    "sample_rate",
+    "gravity",
+    "contact",
+    "plate",
+    "materials",
+    "balls",
+    "sensors",
+)
+SENSOR_NAME = re.compile(r"[A-Za-z0-9_.+-]+")  # used in file names (sensor_<name>.png)
 CONTACT_KEYS = ("exponent", "damping", "penetration", "clamp")
 PLATE_KEYS = ("model", "material", "size")
 MODAL_KEYS = (
@@ -42,7 +60,14 @@ SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonanc
 def load_scene(path) -> Scene:
     """Read and validate the scene file at ``path``. OSError if it cannot be read."""
     path = Path(path)
-    text = path.read_bytes().decode("utf-8", errors="replace")
+    data = path.read_bytes()
+    try:
+        text = data.decode("utf-8-sig")  # a UTF-8 byte-order mark (Windows editors) is fine
+    except UnicodeDecodeError as err:
+        line = data[: err.start].count(b"\n") + 1
+        raise InputError(
+            path.name, f"is not UTF-8 text (invalid byte 0x{data[err.start]:02x} at line {line})"
+        ) from None
     return loads_scene(text, source=path.name)
 
 
@@ -70,7 +95,9 @@ def parse_scene(data: dict) -> Scene:
     kwargs = {}
     if "sample_rate" in data:
         kwargs["sample_rate"] = require_positive("sample_rate", data["sample_rate"])
-    return Scene(
+    if "gravity" in data:
+        kwargs["gravity"] = require_nonnegative("gravity", data["gravity"])
+    scene = Scene(
         balls,
         plate,
         contact,
@@ -80,6 +107,8 @@ def parse_scene(data: dict) -> Scene:
         sensors=sensors,
         **kwargs,
     )
+    check_scene(scene)
+    return scene
 
 
 # -- helpers --------------------------------------------------------------------------------------
@@ -259,11 +288,18 @@ def _first_approach(dx, dy, ux, uy, reach, duration):
 
 
 def _parse_sensors(value, plate: Plate) -> tuple:
+    from tailbeam.sensor import resolve  # scipy.signal: imported only for scenes with sensors
+
     sensors = []
     for i, t in enumerate(_array_of_tables("sensors", value), start=1):
         field = f"sensors[{i}]"
         _check_keys(field, t, SENSOR_KEYS, required=("name", "position"))
         name = _string(f"{field}.name", t["name"])
+        if not SENSOR_NAME.fullmatch(name):
+            raise InputError(
+                f"{field}.name",
+                f"{name!r} may hold only letters, digits and _ . + - (it names output files)",
+            )
         x, y = require_vector(f"{field}.position", t["position"], 2)
         if not plate.contains(x, y):
             raise InputError(f"{field}.position", f"({x!r}, {y!r}) m is not on the plate")
@@ -275,7 +311,15 @@ def _parse_sensors(value, plate: Plate) -> tuple:
         ):
             if key in t:
                 kwargs[arg] = require_real(f"{field}.{key}", t[key])
-        sensors.append(SensorSpec(name, (x, y), **kwargs))
+        try:
+            sensors.append(SensorSpec(name, (x, y), **kwargs))
+            resolve(sensors[-1])  # the chain's own rules (mounted resonance above the band)
+        except InputError as err:  # SensorSpec names itself sensors[<name>]; the file counts
+            raise InputError(err.field.replace(f"sensors[{name}]", field), err.rule) from None
+    names = [s.name for s in sensors]
+    for i, name in enumerate(names, start=1):
+        if name in names[: i - 1]:
+            raise InputError(f"sensors[{i}].name", f"{name!r} is used by an earlier sensor")
     return tuple(sensors)
 
 
@@ -312,7 +356,7 @@ def scene_to_dict(scene: Scene) -> dict:
         for m in sorted(used, key=lambda m: m.name)
         if BUILTIN_MATERIALS.get(m.name) != m
     }
-    out = {"duration": scene.duration, "sample_rate": scene.sample_rate}
+    out = {"duration": scene.duration, "sample_rate": scene.sample_rate, "gravity": scene.gravity}
     out["contact"] = {
         "exponent": c.exponent,
         "damping": c.damping,
@@ -360,7 +404,7 @@ def _toml_value(v) -> str:
 def dumps_scene(scene: Scene) -> str:
     """The scene as scene-file TOML text (``loads_scene(dumps_scene(s)) == s``)."""
     d = scene_to_dict(scene)
-    lines = [f"{k} = {_toml_value(d[k])}" for k in ("duration", "sample_rate")]
+    lines = [f"{k} = {_toml_value(d[k])}" for k in ("duration", "sample_rate", "gravity")]
     for section in ("contact", "plate"):
         lines += ["", f"[{section}]"] + [f"{k} = {_toml_value(v)}" for k, v in d[section].items()]
     for name, props in d.get("materials", {}).items():

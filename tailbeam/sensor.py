@@ -12,7 +12,8 @@ The chain, per ``tailbeam.scene.SensorSpec``:
    its group delay is compensated, as DAQ software does;
 4. sampling at ``sample_rate`` (decimation of the fine grid).
 
-Defaults (README "Sensor chain"): sample rate 51.2 kHz; bandwidth fs/2.56 = 20 kHz, the classic
+Defaults (docs/coupled-and-sensors.md, "Sensor chain"): sample rate 51.2 kHz; bandwidth
+fs/2.56 = 20 kHz, the classic
 FFT-analyser ratio (commercial DAQs quote 0.39-0.45 fs alias-free); mounted resonance 3 x the
 bandwidth (+12.5 % at the band edge, the usual "+/- 1 dB to 1/3 of the mounted resonance"
 rule) with damping ratio 0.03 (Q ~ 17, typical of stud-mounted piezoelectric sensors).

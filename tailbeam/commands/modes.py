@@ -9,7 +9,20 @@ reference only), modes.vtu (ParaView) and modes.png into --out (atomically).
 from tailbeam.bodies import Plate
 from tailbeam.errors import InputError
 from tailbeam.materials import get_material
-from tailbeam.output import atomic_output_dir
+from tailbeam.output import atomic_output_dir, check_output_dir
+
+# library field names -> the options a user typed (tailbeam.cli renames InputError fields)
+CLI_FIELDS = {
+    "boundary": "--bc",
+    "fmax": "--fmax",
+    "count": "--count",
+    "theory": "--theory",
+    "divisions": "--divisions",
+    "mesh": "--mesh",
+    "accuracy": "--accuracy",
+    "material": "--material",
+    "plate": "--size",
+}
 
 
 def add_arguments(parser):
@@ -80,6 +93,7 @@ def run(args) -> int:
     from tailbeam.plate import compute_modes
     from tailbeam.plate.export import write_frequencies_csv, write_png, write_vtu
 
+    check_output_dir(args.out)
     if args.count is not None and args.count < 1:
         raise InputError("count", f"must be >= 1, got {args.count}")
     material = get_material(args.material, field="material")
@@ -118,7 +132,7 @@ def run(args) -> int:
     for i, (label, _) in enumerate(refs):
         print(f"ref{i + 1}: {label}")
     ref, ref_name = refs[0][1] if refs else None, refs[0][0] if refs else ""
-    with atomic_output_dir(args.out) as tmp:
+    with atomic_output_dir(args.out, command="tailbeam modes") as tmp:
         write_frequencies_csv(
             tmp / "frequencies.csv", basis.frequencies_hz, basis.theory, ref, ref_name
         )

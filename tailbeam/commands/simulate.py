@@ -1,26 +1,24 @@
 """`tailbeam simulate SCENE.toml [--out DIR]`: simulate a scene file and write its results.
 
-Writes impacts.csv, impacts.json and timeseries.csv into DIR; for a modal plate also
-sensors.csv, sensor_spectra.csv and one sensor_<name>.png (time and spectrum) per sensor.
-Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
-scene is fully validated before the solver runs, and results go through atomic_output_dir.
+Writes impacts.csv, impacts.json, timeseries.csv (uniform grid) and manifest.json into DIR;
+for a modal plate also sensors.csv, sensor_spectra.csv and one sensor_<name>.png (time and
+spectrum) per sensor. Bad input is reported as one line on stderr with exit code 2, and
+nothing is written: the scene and --out are fully validated before the solver runs, and the
+results replace DIR whole (tailbeam.output), so DIR never mixes two runs.
 """
 
-from tailbeam.figures import sensor_figure
-from tailbeam.output import atomic_output_dir
-from tailbeam.results_io import (
-    result_summary,
-    write_impacts_csv,
-    write_json,
-    write_sensor_spectra_csv,
-    write_sensors_csv,
-    write_timeseries_csv,
-)
-from tailbeam.scene_file import load_scene, scene_to_dict
+import math
+
+from tailbeam.cachedir import announce_first_compile
+from tailbeam.output import atomic_output_dir, check_output_dir, describe
+from tailbeam.progress import note, task
+
+# Heavy modules (scipy.signal, matplotlib) are imported where they are used, so that
+# `tailbeam --help` and bad-input errors answer in a fraction of a second.
 
 
 def add_arguments(parser):
-    parser.add_argument("scene", help="scene file (TOML); keys in README, 'Scene files'")
+    parser.add_argument("scene", help="scene file (TOML); keys in docs/scene-files.md")
     parser.add_argument("--out", default="out/simulate", help="output directory")
 
 
@@ -29,7 +27,10 @@ def solve(scene):
     if scene.plate_model == "rigid":
         from tailbeam.rigid import simulate_rigid
 
-        return simulate_rigid(scene.balls, scene.plate, scene.laws(), scene.duration)
+        with task(f"simulating {scene.duration:g} s, {len(scene.balls)} balls, rigid plate"):
+            return simulate_rigid(
+                scene.balls, scene.plate, scene.laws(), scene.duration, gravity=scene.gravity
+            )
     from tailbeam.coupled import simulate_scene_modal
 
     # The modal path chooses its band from the scene (contact durations, sensor bandwidths),
@@ -37,27 +38,91 @@ def solve(scene):
     return simulate_scene_modal(scene)
 
 
+def _choices(result) -> dict:
+    """What was chosen automatically (band, basis), as recorded by the solver."""
+    info = getattr(result, "info", {}) or {}
+    return {k: info[k] for k in ("band", "basis", "solver") if k in info}
+
+
+def _describe_choices(choices: dict) -> str:
+    band, basis = choices.get("band", {}), choices.get("basis", {})
+    if not band or not basis:
+        return ""
+    fmax = band.get("fmax_hz", math.nan)
+    how = "set by [plate] fmax" if band.get("user_fmax") else "automatic"
+    return (
+        f"modal band {fmax / 1e3:.3g} kHz ({how}), {basis.get('theory')} theory, "
+        f"{basis.get('n_modes')} modes up to {basis.get('top_frequency_hz', math.nan) / 1e3:.3g}"
+        f" kHz, truncation level {band.get('truncation_force_level', math.nan):.2g}"
+    )
+
+
 def write_results(out_dir, scene, result) -> list:
     """Write every output file of ``result`` into ``out_dir`` (an existing directory)."""
+    from tailbeam.results_io import (
+        result_summary,
+        write_impacts_csv,
+        write_json,
+        write_timeseries_csv,
+    )
+    from tailbeam.scene_file import scene_to_dict
+
+    summary = result_summary(result, scene_to_dict(scene))
+    summary["automatic_choices"] = _choices(result)
     files = [
         write_impacts_csv(out_dir / "impacts.csv", result.impacts),
-        write_json(out_dir / "impacts.json", result_summary(result, scene_to_dict(scene))),
+        write_json(out_dir / "impacts.json", summary),
         write_timeseries_csv(out_dir / "timeseries.csv", result, scene.sample_rate),
     ]
     outputs = getattr(result, "sensor_outputs", None)
     if outputs:
-        files.append(write_sensors_csv(out_dir / "sensors.csv", result.sensor_signals))
-        files.append(write_sensor_spectra_csv(out_dir / "sensor_spectra.csv", outputs))
-        files += [
-            sensor_figure(out, out_dir / f"sensor_{name}.png") for name, out in outputs.items()
-        ]
+        with task("writing sensor outputs", total=len(outputs), unit="sensors") as bar:
+            files += _write_sensors(out_dir, scene, result, outputs, bar)
+    return files
+
+
+def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
+    from tailbeam.figures import sensor_figure
+    from tailbeam.results_io import write_sensor_spectra_csv, write_sensors_csv
+
+    meta = {
+        s.name: {
+            "position_m": list(s.position),
+            "sample_rate_hz": outputs[s.name].chain.sample_rate,
+            "bandwidth_hz": outputs[s.name].chain.bandwidth_hz,
+        }
+        for s in scene.sensors
+    }
+    files = [
+        describe(
+            write_sensors_csv(out_dir / "sensors.csv", result.sensor_signals),
+            units={"t": "s", **{n: "m/s^2" for n in outputs}},
+            sensors=meta,
+        ),
+        describe(
+            write_sensor_spectra_csv(out_dir / "sensor_spectra.csv", outputs),
+            units={"freq": "Hz", "amp": "m/s^2 (one-sided peak amplitude)"},
+            sensors=meta,
+        ),
+    ]
+    for name, out in outputs.items():
+        position = tuple(meta[name]["position_m"])
+        files.append(sensor_figure(out, out_dir / f"sensor_{name}.png", position=position))
+        bar.update(1)
     return files
 
 
 def run(args) -> int:
+    from tailbeam.scene_file import load_scene
+
+    check_output_dir(args.out)
     scene = load_scene(args.scene)
+    announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
     result = solve(scene)
-    with atomic_output_dir(args.out) as tmp:
+    line = _describe_choices(_choices(result))
+    if line:
+        note(line)
+    with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:
         files = write_results(tmp, scene, result)
     n = len(result.impacts)
     names = ", ".join(f.name for f in files)

@@ -37,7 +37,7 @@ def contact_durations(scene: Scene, gravity: float = STANDARD_GRAVITY) -> dict:
 def choose_band(scene: Scene, settings: ModalPlateSettings | None = None) -> dict:
     """The modal band for ``scene``: fmax (Hz) with the reasons and the estimated errors."""
     settings = settings or scene.modal or ModalPlateSettings()
-    durations = contact_durations(scene)
+    durations = contact_durations(scene, scene.gravity)
     t_min = min(durations.values())
     f_contact = CONTACT_BAND_FACTOR / t_min
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
@@ -94,6 +94,7 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
         rayleigh=settings.rayleigh,
         residual_flexibility=settings.residual_flexibility,
         coupling=settings.coupling,
+        gravity=scene.gravity,
         **options,
     )
     result.info["band"] = band

@@ -20,14 +20,15 @@ from skfem import MeshTri
 
 from tailbeam import __version__
 from tailbeam.bodies import Plate
+from tailbeam.cachedir import cache_root
 from tailbeam.plate.closed_forms import SHEAR_COEFFICIENT
 
 CACHE_FORMAT = 1  # bump when the stored content or its meaning changes
 
 
 def default_cache_dir() -> Path:
-    env = os.environ.get("TAILBEAM_CACHE_DIR")
-    return Path(env) if env else Path.home() / ".cache" / "tailbeam"
+    """tailbeam's cache folder (tailbeam.cachedir.cache_root)."""
+    return cache_root()
 
 
 def cache_key(

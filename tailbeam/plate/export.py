@@ -4,17 +4,18 @@ I/O only; the physics lives in the other modules.
 """
 
 import csv
+import textwrap
 from pathlib import Path
 
-import matplotlib
+import meshio
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from skfem import MeshTri
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import meshio  # noqa: E402
-import numpy as np  # noqa: E402
-from skfem import MeshTri  # noqa: E402
-
-from tailbeam.modal import ModalBasis  # noqa: E402
+from tailbeam.modal import ModalBasis
+from tailbeam.plate.boundary import CONDITIONS, EDGES
+from tailbeam.plate.mode_labels import label_modes
 
 VTU_REFINE = 2  # each triangle split into 4^2 for a smooth picture of the quintic shapes
 PNG_MODES = 12
@@ -63,8 +64,40 @@ def write_vtu(
     return Path(path)
 
 
+EDGE_STYLES = {  # boundary letter -> how the edge is drawn
+    "C": {"color": "black", "lw": 3.0, "ls": "-"},
+    "S": {"color": "black", "lw": 1.5, "ls": "--"},
+    "F": {"color": "0.45", "lw": 1.2, "ls": ":"},
+}
+
+
+def _edge_segments(a: float, b: float) -> list:
+    """(xs, ys) of the edges left, bottom, right, top (the boundary code's order)."""
+    ha, hb = 0.5 * a, 0.5 * b
+    return [
+        ((-ha, -ha), (-hb, hb)),
+        ((-ha, ha), (-hb, -hb)),
+        ((ha, ha), (-hb, hb)),
+        ((-ha, ha), (hb, hb)),
+    ]
+
+
+def _draw_edges(ax, boundary: str, a: float, b: float) -> None:
+    """Each edge of the plate in its condition's style (EDGE_STYLES)."""
+    for letter, (xs, ys) in zip(boundary, _edge_segments(a, b), strict=True):
+        ax.plot(xs, ys, clip_on=False, **EDGE_STYLES[letter])
+
+
 def write_png(path, basis: ModalBasis, n_modes: int = PNG_MODES) -> Path:
-    """A grid of the first modes' deflection (colour), with frequencies in the titles."""
+    """Write build_modes_figure(basis, n_modes) to ``path`` (PNG); returns the path."""
+    build_modes_figure(basis, n_modes).savefig(path, dpi=110)
+    return Path(path)
+
+
+def build_modes_figure(basis: ModalBasis, n_modes: int = PNG_MODES) -> Figure:
+    """A grid of the first modes' deflection (colour, nodal lines in black) with frequency and
+    (m, n) label in the titles (tailbeam.plate.mode_labels) and the edge conditions drawn on
+    every panel (solid: clamped, dashed: simply supported, dotted: free)."""
     plate = basis.plate
     n = min(n_modes, basis.n_modes)
     a, b = plate.size_x, plate.size_y
@@ -72,26 +105,56 @@ def write_png(path, basis: ModalBasis, n_modes: int = PNG_MODES) -> Path:
     y = np.linspace(-0.5 * b, 0.5 * b, PNG_GRID)
     xx, yy = np.meshgrid(x, y)
     phi = basis.deflection(np.column_stack([xx.ravel(), yy.ravel()]))[:, :n]
+    shapes = [phi[:, i].reshape(xx.shape) for i in range(n)]
+    labels = label_modes(basis.boundary, shapes, x, y, a, b)
     cols = min(4, n)
     rows = int(np.ceil(n / cols))
-    fig, axes = plt.subplots(rows, cols, figsize=(3.0 * cols, 3.0 * rows), squeeze=False)
+    width = max(3.0 * cols, 6.0)
+    fig = Figure(figsize=(width, 3.0 * rows + 1.2), layout="constrained")
+    axes = fig.subplots(rows, cols, squeeze=False)
     for i, ax in enumerate(axes.ravel()):
         ax.set_axis_off()
         if i >= n:
             continue
-        z = phi[:, i].reshape(xx.shape)
+        z = shapes[i]
         lim = np.abs(z).max() or 1.0
         ax.pcolormesh(xx, yy, z, cmap="RdBu_r", vmin=-lim, vmax=lim, shading="auto")
-        # nodal lines, inside only (the supported edges are zero everywhere)
+        # nodal lines, inside only (supported or clamped edges are zero everywhere)
         ax.contour(
             xx[1:-1, 1:-1], yy[1:-1, 1:-1], z[1:-1, 1:-1], levels=[0.0], colors="k", linewidths=0.6
         )
+        _draw_edges(ax, basis.boundary, a, b)
         ax.set_aspect("equal")
-        ax.set_title(f"mode {i + 1}: {basis.frequencies_hz[i]:.1f} Hz", fontsize=9)
-    fig.suptitle(
-        f"{basis.boundary} plate, {basis.theory} ({basis.info.get('element', '')})", fontsize=10
+        ax.set_title(
+            f"mode {i + 1}: {basis.frequencies_hz[i]:.1f} Hz\n{labels[i].text()}", fontsize=8
+        )
+    fig.suptitle(_heading(basis, width), fontsize=9)
+    fig.legend(handles=_legend_handles(), loc="outside lower center", ncols=4, fontsize=8)
+    return fig
+
+
+def _heading(basis: ModalBasis, width_in: float) -> str:
+    """Title lines: plate, theory, edge conditions, how to read a panel; wrapped to fit a
+    figure ``width_in`` inches wide (at 9 pt, about 14 characters per inch)."""
+    edges = ", ".join(
+        f"{edge} {CONDITIONS[c]}" for edge, c in zip(EDGES, basis.boundary, strict=True)
     )
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    plate = basis.plate
+    meaning = (
+        "(m, n): the SSSS sine sin(m pi x/a) sin(n pi y/b) with the largest share of the shape"
+        if basis.boundary == "SSSS"
+        else "nodal (m, n): 1 + nodal lines crossed along x, along y (a half-wave count, "
+        "not a closed-form index)"
+    )
+    lines = [
+        f"{basis.boundary} plate {plate.size_x:g} x {plate.size_y:g} x {plate.thickness:g} m, "
+        f"{basis.theory} ({basis.info.get('element', '')})",
+        f"edges: {edges}",
+        "x to the right, y up; colour: deflection (red +, blue -), black: nodal lines",
+        meaning,
+    ]
+    return "\n".join(textwrap.fill(line, int(14 * width_in)) for line in lines)
+
+
+def _legend_handles() -> list:
+    return [Line2D([], [], label=CONDITIONS[c], **style) for c, style in EDGE_STYLES.items()]

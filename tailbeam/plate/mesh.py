@@ -5,6 +5,8 @@ Edges are named 'left' (x = -a/2), 'bottom' (y = -b/2), 'right' (x = +a/2), 'top
 the plate is centred on the origin (tailbeam.bodies). Coordinates in m.
 """
 
+import contextlib
+import io
 from pathlib import Path
 
 import meshio
@@ -128,11 +130,15 @@ def load_mesh(path, plate: Plate, field: str = "mesh") -> MeshTri:
     path = Path(path)
     if not path.is_file():
         raise InputError(field, f"mesh file {str(path)!r} does not exist")
+    said = io.StringIO()
     try:
-        # .msh is ambiguous to meshio (ANSYS or Gmsh); say Gmsh to skip a noisy failed try
-        raw = meshio.read(path, file_format="gmsh" if path.suffix == ".msh" else None)
-    except Exception as err:  # meshio raises many types for unreadable files
-        raise InputError(field, f"cannot read mesh file {str(path)!r}: {err}") from None
+        # .msh is ambiguous to meshio (ANSYS or Gmsh); say Gmsh to skip a noisy failed try.
+        # meshio prints to stderr and may call sys.exit on files it cannot read: catch both.
+        with contextlib.redirect_stderr(said), contextlib.redirect_stdout(said):
+            raw = meshio.read(path, file_format="gmsh" if path.suffix == ".msh" else None)
+    except (Exception, SystemExit) as err:  # meshio raises many types for unreadable files
+        why = " ".join(said.getvalue().split()) or str(err) or type(err).__name__
+        raise InputError(field, f"cannot read mesh file {str(path)!r}: {why}") from None
     if "triangle" not in raw.cells_dict:
         raise InputError(field, f"mesh file {str(path)!r} has no triangles")
     mesh = from_meshio(raw)

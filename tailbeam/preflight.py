@@ -1,0 +1,105 @@
+"""Checks of a whole scene before any work starts: the contact law is used where it is valid,
+and the outputs fit in memory and on disk.
+
+Each check raises InputError naming the scene key to change (``contact.exponent``,
+``balls[2].velocity``, ``sensors[1].sample_rate``) and the rule, so a scene that would crash,
+hang or allocate without bound is refused in milliseconds, before the solver starts.
+
+Rules (and why):
+- Penetration: the undamped (upper-bound) maximum penetration of every ball's hardest impact
+  (speed after falling from its start, tailbeam.hertz) must stay below
+  ``MAX_PENETRATION_FRACTION`` of its radius. Hertz theory, which gives k, assumes small
+  deformation; far beyond that the law is used outside its validity (an exponent of 1e6
+  makes the force vanish below 1 m of penetration).
+- Damping: the contact damping ratio c / (2 sqrt(k_d m)) with the contact stiffness
+  k_d = e k d^(e-1) at the end of the STEP ramp must stay below ``MAX_CONTACT_DAMPING_RATIO``.
+  Measured for coal on steel at 1 m/s: restitution 0.11 at a ratio of 2.8, 0.016 at 28 and
+  0 at 280 (the impact ends at rest inside the contact); larger values change nothing
+  physical and only drive the contact integrator's step below machine resolution (1e300
+  ended in "step size underflow").
+- Output size: timeseries.csv rows x columns and every sensor's samples are bounded
+  (``MAX_TIMESERIES_VALUES``, ``MAX_SENSOR_SAMPLES``); a sensor needs ``MIN_SENSOR_SAMPLES``
+  over the duration for a spectrum.
+"""
+
+import math
+
+from tailbeam.errors import InputError
+from tailbeam.hertz import hertz_max_penetration
+
+MAX_PENETRATION_FRACTION = 0.1  # of the ball radius
+MAX_CONTACT_DAMPING_RATIO = 1e4
+MAX_TIMESERIES_VALUES = 20_000_000  # ~300 MB of CSV
+MAX_SENSOR_SAMPLES = 20_000_000  # per sensor; the chain works on a grid 2-4x finer
+MIN_SENSOR_SAMPLES = 16
+
+
+def impact_speed(ball, gravity: float) -> float:
+    """Largest speed (m/s) the ball can reach the plate with: sqrt(vz^2 + 2 g gap)."""
+    return math.sqrt(ball.velocity[2] ** 2 + 2.0 * gravity * max(ball.gap, 0.0))
+
+
+def check_contacts(scene) -> None:
+    """Penetration and damping rules (module docstring) for every ball of ``scene``."""
+    for i, (ball, law) in enumerate(zip(scene.balls, scene.laws(), strict=True), start=1):
+        speed = impact_speed(ball, scene.gravity)
+        if speed > 0.0:
+            _check_penetration(i, ball, law, speed)
+        k_d = law.exponent * law.stiffness * law.penetration ** (law.exponent - 1.0)
+        ratio = law.damping / (2.0 * math.sqrt(k_d * ball.mass))
+        if ratio > MAX_CONTACT_DAMPING_RATIO:
+            limit = MAX_CONTACT_DAMPING_RATIO * 2.0 * math.sqrt(k_d * ball.mass)
+            raise InputError(
+                "contact.damping",
+                f"{law.damping:.3g} N s/m gives ball {ball.name!r} a contact damping ratio "
+                f"of {ratio:.3g}; it must be <= {MAX_CONTACT_DAMPING_RATIO:g} "
+                f"(c <= {limit:.3g} N s/m here; impacts end at rest from a ratio of ~300)",
+            )
+
+
+def _check_penetration(i, ball, law, speed) -> None:
+    depth = hertz_max_penetration(ball.mass, speed, law.stiffness, law.exponent)
+    allowed = MAX_PENETRATION_FRACTION * ball.radius
+    if depth <= allowed:
+        return
+    field = "contact.exponent" if law.exponent != 1.5 else f"balls[{i}].velocity"
+    raise InputError(
+        field,
+        f"ball {ball.name!r} would penetrate the plate by {depth:.3g} m at {speed:.3g} m/s "
+        f"with exponent {law.exponent:g}, more than {MAX_PENETRATION_FRACTION:g} of its radius "
+        f"({allowed:.3g} m): the Hertz contact law is valid for small deformation only",
+    )
+
+
+def check_outputs(scene) -> None:
+    """Size rules for timeseries.csv and the sensors (module docstring)."""
+    rows = math.floor(scene.duration * scene.sample_rate) + 1
+    values = rows * (1 + 3 * len(scene.balls))
+    if values > MAX_TIMESERIES_VALUES:
+        raise InputError(
+            "sample_rate",
+            f"timeseries.csv would hold {rows:.3g} rows x {1 + 3 * len(scene.balls)} columns "
+            f"({values:.3g} values, limit {MAX_TIMESERIES_VALUES:.3g}); lower sample_rate or "
+            "duration",
+        )
+    for i, sensor in enumerate(scene.sensors, start=1):
+        n = scene.duration * sensor.sample_rate
+        field = f"sensors[{i}].sample_rate"
+        if n > MAX_SENSOR_SAMPLES:
+            raise InputError(
+                field,
+                f"{sensor.sample_rate:g} Hz over {scene.duration:g} s is {n:.3g} samples, limit "
+                f"{MAX_SENSOR_SAMPLES:.3g}; lower it or the duration",
+            )
+        if n < MIN_SENSOR_SAMPLES:
+            raise InputError(
+                field,
+                f"{sensor.sample_rate:g} Hz over {scene.duration:g} s gives {n:.3g} samples; a "
+                f"signal and its spectrum need at least {MIN_SENSOR_SAMPLES}",
+            )
+
+
+def check_scene(scene) -> None:
+    """Every preflight rule; raises InputError on the first broken one."""
+    check_contacts(scene)
+    check_outputs(scene)
