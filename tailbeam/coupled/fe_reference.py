@@ -32,6 +32,7 @@ from scipy.optimize import brentq
 from tailbeam.bodies import STANDARD_GRAVITY, Ball
 from tailbeam.contact_law import ImpactLaw, impact_force_scalar
 from tailbeam.errors import InputError, WorkLimitError, require_positive
+from tailbeam.progress import task
 
 DEFAULT_MAX_WORK = 1e11  # steps x 10 x matrix nonzeros; 1e11 is ~1-2 min on one core
 
@@ -189,18 +190,34 @@ def fe_reference(
             f"{model.n_dofs} DOFs) > max_work={max_work:.2g}; raise dt or max_work, or use a "
             "coarser mesh"
         )
-    point = ball.position[:2]
-    load = model.load_vector(point, load_radius)
+    load = model.load_vector(ball.position[:2], load_radius)
     plate = _Plate(model, dt, rayleigh, load)
     probe = model.deflection_operator(np.reshape(sensors, (-1, 2))) if len(sensors) else None
-    n = model.n_dofs
+    with task("FE reference (Newmark)", total=n_steps, unit="steps") as bar:
+        hist, vz_hist, sw, sa = _integrate(plate, probe, ball, law, n_steps, gravity, bar)
+    t_hist = dt * np.arange(n_steps + 1)
+    return FEReferenceResult(
+        t=t_hist,
+        force=hist[0],
+        penetration=hist[1],
+        sensor_w=sw,
+        sensor_a=sa,
+        impacts=_impacts(t_hist, hist, vz_hist, dt),
+        dt=dt,
+        n_dofs=model.n_dofs,
+        info={"load_radius": load_radius, "rayleigh": tuple(rayleigh), "steps": n_steps},
+    )
+
+
+def _integrate(plate, probe, ball, law, n_steps, gravity, bar):
+    """The Newmark steps: histories (force, penetration, its rate), ball speeds, sensors."""
+    dt, load = plate.dt, plate.f
+    n = plate.K.shape[0]
     u, v, a = np.zeros(n), np.zeros(n), np.zeros(n)
     m, radius = ball.mass, ball.radius
-    z, vz, az, force = ball.position[2], ball.velocity[2], -gravity, 0.0
-    t_hist = dt * np.arange(n_steps + 1)
+    z, vz, az = ball.position[2], ball.velocity[2], -gravity
     hist = np.zeros((3, n_steps + 1))  # force, penetration, penetration rate
-    hist[1, 0] = radius - z
-    hist[2, 0] = -vz
+    hist[1, 0], hist[2, 0] = radius - z, -vz
     p = 0 if probe is None else probe.shape[0]
     sw, sa = np.zeros((p, n_steps + 1)), np.zeros((p, n_steps + 1))
     s_d = plate.s_w + dt**2 / (4.0 * m)
@@ -215,27 +232,17 @@ def fe_reference(
         wd0 = 2.0 / dt * (w0 - float(load @ u)) - float(load @ v)
         force = _contact_force(law, radius - zb + w0, -vb + wd0, s_d, s_v)
         u, v, a = plate.correct(u, v, a, u_hat, force)
-        az_new = -gravity + force / m
+        az = -gravity + force / m
         z = zb + 0.25 * dt**2 * force / m
         vz = vb + 0.5 * dt * force / m
-        az = az_new
         hist[:, k] = force, radius - z + float(load @ u), -vz + float(load @ v)
         vz_hist[k] = vz
         if probe is not None:
             sw[:, k] = probe @ u
             sa[:, k] = probe @ a
-    impacts = _impacts(t_hist, hist, vz_hist, dt)
-    return FEReferenceResult(
-        t=t_hist,
-        force=hist[0],
-        penetration=hist[1],
-        sensor_w=sw,
-        sensor_a=sa,
-        impacts=impacts,
-        dt=dt,
-        n_dofs=n,
-        info={"load_radius": load_radius, "rayleigh": tuple(rayleigh), "steps": n_steps},
-    )
+        if k % 1000 == 0:
+            bar.update(1000)
+    return hist, vz_hist, sw, sa
 
 
 def _impacts(t, hist, vz, dt):
