@@ -12,10 +12,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tailbeam.bodies import Plate
+from tailbeam.contact_patch import disc_rule
 from tailbeam.errors import InputError
 
 PointEvaluator = Callable[[np.ndarray], np.ndarray]
+NAVIER_TERMS = 2000  # per direction
 ComplianceEvaluator = Callable[[np.ndarray, float], np.ndarray]
+DeflectionEvaluator = Callable[[np.ndarray, np.ndarray, float], np.ndarray]
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,6 +39,7 @@ class ModalBasis:
     theory: str
     boundary: str
     static_compliance_at: ComplianceEvaluator | None = None
+    static_deflection_at: DeflectionEvaluator | None = None
     info: dict = field(default_factory=dict)
 
     @property
@@ -69,23 +73,54 @@ class ModalBasis:
             theory=self.theory,
             boundary=self.boundary,
             static_compliance_at=self.static_compliance_at,
+            static_deflection_at=self.static_deflection_at,
             info=dict(self.info),
         )
 
-    def residual_compliance(self, points, contact_radius: float = 0.0) -> np.ndarray:
-        """Static compliance (m/N) of the modes left out, at each point: the full model's
-        static compliance minus the part the kept modes carry, sum phi_i^2 / omega_i^2."""
-        if self.static_compliance_at is None:
+    def load_deflection(self, points, contact_radius: float = 0.0) -> np.ndarray:
+        """(p, n) modal deflections averaged over a disc of ``contact_radius`` m about each
+        point (tailbeam.contact_patch.disc_rule; radius 0: at the point): the modal force of
+        a unit load spread over the disc, and the mean plate deflection there."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        if contact_radius == 0.0:
+            return self.deflection(points)
+        rows = []
+        for p in points:
+            pts, weights = disc_rule(self.plate, p, contact_radius)
+            rows.append(weights @ self.deflection(pts))
+        return np.array(rows)
+
+    def _require_static(self, what):
+        if what is None:
             raise InputError(
                 "plate.residual_flexibility",
                 f"the {self.theory} {self.boundary} model provides no static compliance; "
                 "switch residual flexibility off",
             )
+
+    def residual_compliance(self, points, contact_radius: float = 0.0) -> np.ndarray:
+        """Static compliance (m/N) of the modes left out, at each point: the full model's
+        static compliance minus the part the kept modes carry, sum phibar_i^2 / omega_i^2,
+        both for the same load (1 N over a disc of ``contact_radius`` m; 0: a point load;
+        phibar = ``load_deflection``), so the residual vanishes when every mode is kept."""
+        self._require_static(self.static_compliance_at)
         points = np.atleast_2d(np.asarray(points, dtype=float))
         full = np.asarray(self.static_compliance_at(points, contact_radius), dtype=float)
-        phi = self.deflection(points)
+        phi = self.load_deflection(points, contact_radius)
         kept = np.sum(phi**2 / self.omega**2, axis=1)
         return np.maximum(full - kept, 0.0)
+
+    def residual_cross_compliance(self, load_point, points, contact_radius=0.0) -> np.ndarray:
+        """(p,) static deflection (m/N) of the modes left out at ``points`` under a unit load
+        at ``load_point`` (spread as in ``residual_compliance``): the full model's static
+        deflection minus sum phi_i(points) phibar_i(load) / omega_i^2. Times the contact force
+        it is the truncated modes' quasi-static (mode-acceleration) response at a sensor."""
+        self._require_static(self.static_deflection_at)
+        load_point = np.asarray(load_point, dtype=float).reshape(2)
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        full = np.asarray(self.static_deflection_at(load_point, points, contact_radius))
+        phibar = self.load_deflection([load_point], contact_radius)[0]
+        return full - self.deflection(points) @ (phibar / self.omega**2)
 
 
 def ssss_kirchhoff_frequencies(plate: Plate, m, n) -> np.ndarray:
@@ -105,7 +140,8 @@ def ssss_kirchhoff_basis(plate: Plate, fmax_hz: float) -> ModalBasis:
     """Exact Kirchhoff modes of the simply supported plate below ``fmax_hz``.
 
     phi_mn = 2/sqrt(rho h a b) sin(m pi (x + a/2)/a) sin(n pi (y + b/2)/b).
-    The static compliance is the Navier double series, summed to 1e-6 relative.
+    The static compliance and cross compliance (point loads, the Kirchhoff load model) are
+    the Navier double series, summed to 1e-6 relative.
     """
     a, b = plate.size_x, plate.size_y
     f1 = ssss_kirchhoff_frequencies(plate, 1, 1)
@@ -125,18 +161,28 @@ def ssss_kirchhoff_basis(plate: Plate, fmax_hz: float) -> ModalBasis:
         y = points[:, 1:2] + 0.5 * b
         return amp * np.sin(m_idx * np.pi * x / a) * np.sin(n_idx * np.pi * y / b)
 
-    def static_compliance_at(points: np.ndarray, contact_radius: float = 0.0) -> np.ndarray:
+    def navier(load_point, point):
         # Navier series; terms fall like 1/(m^2 + n^2)^2, so the tail beyond N is O(1/N^2).
-        N = 2000
-        k = np.arange(1, N + 1)
-        out = np.empty(len(points))
+        k = np.arange(1, NAVIER_TERMS + 1)
+        sx = np.sin(k * np.pi * (load_point[0] + 0.5 * a) / a)
+        sx = sx * np.sin(k * np.pi * (point[0] + 0.5 * a) / a)
+        sy = np.sin(k * np.pi * (load_point[1] + 0.5 * b) / b)
+        sy = sy * np.sin(k * np.pi * (point[1] + 0.5 * b) / b)
+        denom = (k[:, None] ** 2 / a**2 + k[None, :] ** 2 / b**2) ** 2
         d_over = plate.bending_stiffness * np.pi**4
-        for i, (px, py) in enumerate(points):
-            sx = np.sin(k * np.pi * (px + 0.5 * a) / a) ** 2
-            sy = np.sin(k * np.pi * (py + 0.5 * b) / b) ** 2
-            denom = (k[:, None] ** 2 / a**2 + k[None, :] ** 2 / b**2) ** 2
-            out[i] = 4.0 / (a * b * d_over) * np.sum(sx[:, None] * sy[None, :] / denom)
-        return out
+        return 4.0 / (a * b * d_over) * np.sum(sx[:, None] * sy[None, :] / denom)
+
+    def point_load_only(contact_radius):
+        if contact_radius != 0.0:
+            raise InputError("contact_radius", "the closed-form Kirchhoff basis takes point loads")
+
+    def static_compliance_at(points: np.ndarray, contact_radius: float = 0.0) -> np.ndarray:
+        point_load_only(contact_radius)
+        return np.array([navier(p, p) for p in points])
+
+    def static_deflection_at(load_point, points, contact_radius: float = 0.0) -> np.ndarray:
+        point_load_only(contact_radius)
+        return np.array([navier(load_point, p) for p in np.atleast_2d(points)])
 
     return ModalBasis(
         plate=plate,
@@ -145,5 +191,6 @@ def ssss_kirchhoff_basis(plate: Plate, fmax_hz: float) -> ModalBasis:
         theory="kirchhoff-closed-form",
         boundary="SSSS",
         static_compliance_at=static_compliance_at,
+        static_deflection_at=static_deflection_at,
         info={"m": m_idx, "n": n_idx},
     )

@@ -100,7 +100,11 @@ def _impact(steps, residual=True, fmax=10000.0, damping=800.0):
     res = simulate_coupled([ball], basis, [law], 1e-3, steps_per_contact=steps,
                            residual_flexibility=residual)  # fmt: skip
     imp = res.impacts[0]
-    acc = res.plate_sample(np.linspace(0, 1e-3, 1001), [SENSOR])["a"][0]
+    # the integrator's order is measured on the kept modes: the truncated modes' quasi-static
+    # term is a post-processing of the same forces whose full-band 1 us samples resolve the
+    # kinks of the piecewise-linear force (its in-band convergence: tests/test_coupled_fe.py)
+    times = np.linspace(0, 1e-3, 1001)
+    acc = res.plate_sample(times, [SENSOR], quasi_static=False)["a"][0]
     return np.array([imp.restitution, imp.peak_force, imp.t_end - imp.t_start]), acc
 
 
@@ -215,10 +219,15 @@ def test_slow_chatter_comes_to_rest():
         inside |= (t >= imp.t_start) & (t <= imp.t_end)
     gap = res.sample(t)["b"]["z"] - R - res.plate_sample(t, [(0.1, 0.05)])["w"][0]
     assert len(res.impacts_of("b")) > 5 and np.min(gap[~inside]) > -1e-12
-    w_end = res.plate_sample([1.0], [(0.1, 0.05)])["w"][0, 0]
+    # the kept modes carry m g sum phi^2/omega^2; the truncated modes' quasi-static part adds
+    # the rest of the full static deflection (residual flexibility is on)
+    w_end = res.plate_sample([1.0], [(0.1, 0.05)])
     phi = basis.deflection([(0.1, 0.05)])[0]
     static_modal = -ball.mass * 9.80665 * np.sum(phi**2 / basis.omega**2)
-    assert w_end == pytest.approx(static_modal, rel=1e-3)
+    kept = res.plate_sample([1.0], [(0.1, 0.05)], quasi_static=False)["w"][0, 0]
+    assert kept == pytest.approx(static_modal, rel=1e-3)
+    static_full = -ball.mass * 9.80665 * basis.static_compliance_at([(0.1, 0.05)])[0]
+    assert w_end["w"][0, 0] == pytest.approx(static_full, rel=1e-3)
 
 
 def test_rayleigh_damping_ratios():

@@ -14,6 +14,7 @@ piecewise-linear force (the same node representation as the two-way result).
 import numpy as np
 
 from tailbeam.bodies import STANDARD_GRAVITY
+from tailbeam.contact_patch import load_radius
 from tailbeam.coupled.result import CoupledResult
 from tailbeam.rigid import simulate_rigid
 
@@ -54,7 +55,10 @@ def simulate_one_way(
     vz = np.column_stack([states[n]["vz"] for n in names])
     force = np.column_stack([states[n]["force"] for n in names])
     delta = np.array([b.radius for b in balls])[None, :] - z
-    phi = basis.deflection(np.array([b.position[:2] for b in balls]))
+    # the same load model as the two-way solver: a point (Kirchhoff) or the Hertz disc (Mindlin)
+    radii = [load_radius(basis.theory, b, lw, gravity) for b, lw in zip(balls, laws, strict=True)]
+    phi = np.array([basis.load_deflection([balls[i].position[:2]], radii[i])[0]
+                    for i in range(len(balls))])  # fmt: skip
     omega = np.asarray(basis.omega)
     return CoupledResult(
         balls=tuple(balls),

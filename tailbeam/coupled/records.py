@@ -13,10 +13,10 @@ _COMPLIANCE_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 class Compliance:
-    """Residual compliance at contact points, cached per basis (the Navier sum is slow).
+    """Residual compliance at contact points, cached per basis (the static solve is slow).
 
-    The contact radius enters on a 5 % logarithmic grid: the compliance of a load spread over
-    a disc depends on the radius only logarithmically (Mindlin) or not at all (Kirchhoff)."""
+    radius: the load model's disc radius (tailbeam.contact_patch.load_radius, already on its
+    5 % logarithmic grid; 0 for a point load)."""
 
     def __init__(self, basis: ModalBasis, enabled: bool):
         self.basis = basis
@@ -26,11 +26,9 @@ class Compliance:
     def __call__(self, x, y, radius):
         if not self.enabled:
             return 0.0
-        r_key = round(math.log(max(radius, 1e-12)) / 0.05)
-        key = (round(x, 9), round(y, 9), r_key)
+        key = (round(x, 9), round(y, 9), radius)
         if key not in self.cache:
-            r = math.exp(0.05 * r_key)
-            self.cache[key] = float(self.basis.residual_compliance([[x, y]], r)[0])
+            self.cache[key] = float(self.basis.residual_compliance([[x, y]], radius)[0])
         return self.cache[key]
 
 

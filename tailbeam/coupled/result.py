@@ -36,10 +36,12 @@ class CoupledResult:
     seg_phase: np.ndarray = field(repr=False)
     phis: np.ndarray = field(repr=False)
     sensors: tuple = ()
+    contact_points: tuple = ()  # (t_start s, ball index, x m, y m, load radius m) per contact
     n_steps: int = 0
     status: int = 0
     message: str = ""
     info: dict = field(default_factory=dict)
+    _cross: dict = field(default_factory=dict, repr=False)  # residual cross compliances
 
     @property
     def nfev(self) -> int:
@@ -116,12 +118,65 @@ class CoupledResult:
         inv[order] = np.arange(len(order))
         return q[:, inv], qd[:, inv], qdd[:, inv]
 
-    def plate_sample(self, times, points) -> dict:
+    def plate_sample(self, times, points, *, quasi_static: bool = True) -> dict:
         """Plate deflection "w" (m, + up), velocity "v" (m/s), acceleration "a" (m/s^2) at
-        points (p, 2) m and times (s): each array (p, len(times))."""
+        points (p, 2) m and times (s): each array (p, len(times)). The kept modes exactly,
+        plus (quasi_static, with residual flexibility on) the truncated modes' quasi-static
+        response (``quasi_static_sample``)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
         phi = np.ascontiguousarray(self.basis.deflection(points), dtype=float)
         w, v, a = self._replay(times, phi)
+        if quasi_static and self.has_quasi_static:
+            qs = self.quasi_static_sample(times, points)
+            w, v, a = w + qs["w"], v + qs["v"], a + qs["a"]
         return {"w": w, "v": v, "a": a}
+
+    @property
+    def has_quasi_static(self) -> bool:
+        """True if the truncated modes' quasi-static response is added at points (residual
+        flexibility on and a basis that knows its static cross compliance)."""
+        return bool(
+            self.info.get("residual_flexibility")
+            and self.contact_points
+            and getattr(self.basis, "static_deflection_at", None) is not None
+        )
+
+    def quasi_static_sample(self, times, points) -> dict:
+        """The truncated modes' quasi-static (mode-acceleration) response at points (p, 2) m:
+        w = -G_res F(t) (F pushes the plate down), G_res the residual cross compliance between
+        the ball's contact and each point (ModalBasis.residual_cross_compliance, with the
+        contact's load model).
+        v and a are its central differences over +-h: h is the spacing of uniform ``times``
+        (so a sampled record is the exact second difference of the sampled force: gain
+        sinc^2(f h), no aliasing of the force's kinks), else 1/(8 f_top). Arrays (p, len)."""
+        t = np.atleast_1d(np.asarray(times, dtype=float))
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        out = {k: np.zeros((len(points), len(t))) for k in ("w", "v", "a")}
+        h = _difference_step(t, float(np.max(self.basis.frequencies_hz)))
+        tn, _z, _v, fn, _d = self.nodes
+        for b in range(len(self.balls)):
+            mine = [c for c in self.contact_points if c[1] == b]
+            if not mine:
+                continue
+            # each time belongs to the last contact started by t + h (its differences use it)
+            which = np.searchsorted([c[0] for c in mine], t + h, side="right") - 1
+            which = np.maximum(which, 0)
+            f = [np.interp(t + s, tn, fn[:, b], left=0.0) for s in (-h, 0.0, h)]
+            parts = (f[1], (f[2] - f[0]) / (2 * h), (f[2] - 2 * f[1] + f[0]) / h**2)
+            for k, (_ts, _b, x, y, r) in enumerate(mine):
+                sel = which == k
+                if not sel.any():
+                    continue
+                g = -self._cross_compliance(x, y, r, points)  # the ball pushes the plate down
+                for key, part in zip(("w", "v", "a"), parts, strict=True):
+                    out[key][:, sel] += g[:, None] * part[sel]
+        return out
+
+    def _cross_compliance(self, x, y, r, points):
+        key = (x, y, r, points.tobytes())
+        if key not in self._cross:
+            self._cross[key] = self.basis.residual_cross_compliance((x, y), points, r)
+        return self._cross[key]
 
     def plate_energy(self, times) -> np.ndarray:
         """Vibration energy of the plate's kept modes, J, at ``times``."""
@@ -148,3 +203,12 @@ class CoupledResult:
     def sensor_signals(self) -> dict:
         """name -> (t array s, acceleration array m/s^2) as sampled by each sensor."""
         return {name: (out.t, out.acceleration) for name, out in self.sensor_outputs.items()}
+
+
+def _difference_step(t, f_top):
+    """Spacing of uniform times t (s), else 1/(8 f_top) s (see quasi_static_sample)."""
+    if len(t) >= 3:
+        d = np.diff(t)
+        if d[0] > 0 and np.all(np.abs(d - d[0]) <= 1e-6 * d[0]):
+            return float(d[0])
+    return 1.0 / (8.0 * f_top)

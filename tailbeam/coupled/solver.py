@@ -13,12 +13,13 @@ import numpy as np
 
 from tailbeam.bodies import STANDARD_GRAVITY, Ball, check_ball_above_plate
 from tailbeam.contact_law import ImpactLaw
+from tailbeam.contact_patch import load_radius
 from tailbeam.coupled import kernel as K
 from tailbeam.coupled import step as S
 from tailbeam.coupled.records import Compliance, close_contact
 from tailbeam.coupled.result import CoupledResult
 from tailbeam.errors import InputError, WorkLimitError, require_positive
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration
+from tailbeam.hertz import hertz_contact_duration
 from tailbeam.modal import ModalBasis
 from tailbeam.progress import task
 
@@ -134,6 +135,11 @@ def simulate_coupled(
     vx = np.array([b.velocity[0] for b in balls])
     vy = np.array([b.velocity[1] for b in balls])
     compliance = Compliance(basis, residual_flexibility)
+    # the load model (tailbeam.contact_patch): a point (Kirchhoff) or the Hertz disc (Mindlin)
+    rload = [load_radius(basis.theory, b, lw, gravity) for b, lw in zip(balls, laws, strict=True)]
+
+    def shape(b, px, py):
+        return basis.load_deflection([[px, py]], rload[b])[0]
 
     def xy(b, t):
         return x0[b] + vx[b] * t, y0[b] + vy[b] * t
@@ -151,7 +157,7 @@ def simulate_coupled(
     cur[0] = radius - z
     cur[1] = -vz
     cur[3] = vz
-    phi = np.ascontiguousarray(basis.deflection(np.column_stack([x0, y0])))
+    phi = np.ascontiguousarray([shape(b, x0[b], y0[b]) for b in range(nb)], dtype=float)
     cres = np.zeros(nb)
     h = np.zeros(nb)
 
@@ -170,7 +176,7 @@ def simulate_coupled(
     nbuf = 1
     seg_phase = [0]
     phis = [phi.copy()]
-    events, impacts, open_contacts = [], [], {}
+    events, impacts, open_contacts, contact_points = [], [], {}, []
     counts = [0] * nb
     rest_time = {b.name: math.nan for b in balls}
     evout = np.zeros(2, dtype=np.int64)
@@ -192,7 +198,7 @@ def simulate_coupled(
                 if not plate.contains(px, py):
                     mode[b] = S.OFF
                     continue
-                phi[b] = basis.deflection([[px, py]])[0]
+                phi[b] = shape(b, px, py)
                 # refresh again after 1 mm of lateral travel (mode shapes vary on ~ cm scales)
                 t_stop = min(t_stop, t + 1e-3 / math.hypot(vx[b], vy[b]))
             if mode[b] in (S.CONTACT, S.CLAMPED):
@@ -261,12 +267,12 @@ def simulate_coupled(
         events.append((t, name, _EVENT_NAMES[kind]))
         if kind == K.EV_START:
             px, py = xy(b, t)
-            phi[b] = basis.deflection([[px, py]])[0]
+            phi[b] = shape(b, px, py)
+            contact_points.append((t, b, px, py, rload[b]))
             w_rel = float(phi[b] @ qd)
             speed = max(w_rel - vz[b], 1e-6)
             h[b] = nominal_step(b, speed)
-            delta_m = hertz_max_penetration(mass[b], max(speed, 1e-3), kk[b], ee[b])
-            cres[b] = compliance(px, py, math.sqrt(radius[b] * delta_m))
+            cres[b] = compliance(px, py, rload[b])
             counts[b] += 1
             open_contacts[b] = {
                 "index": counts[b],
@@ -339,6 +345,7 @@ def simulate_coupled(
         seg_phase=np.asarray(seg_phase[:nbuf], dtype=np.int64),
         phis=np.ascontiguousarray(np.array(phis)),
         sensors=tuple(sensors),
+        contact_points=tuple(contact_points),
         n_steps=total_steps,
         status=status,
         message=message,

@@ -10,6 +10,7 @@ import scipy.sparse as sp
 from skfem import Basis, MeshTri, condense
 
 from tailbeam.bodies import Plate
+from tailbeam.contact_patch import disc_rule
 from tailbeam.errors import InputError, require_nonnegative
 from tailbeam.plate.boundary import parse_boundary
 from tailbeam.plate.kirchhoff import ELEMENT_NAME as KIRCHHOFF_ELEMENT
@@ -19,27 +20,6 @@ from tailbeam.plate.mindlin import DEFAULT_DEGREE, assemble_mindlin
 from tailbeam.plate.sparse_solve import SymmetricSolver
 
 THEORIES = ("kirchhoff", "mindlin")
-DISC_RINGS, DISC_SPOKES = 4, 12  # 48-point polar rule for a load spread over a disc
-
-
-def disc_rule(plate: Plate, center, radius: float):
-    """Points (q, 2) and weights (q,) summing to 1 for a uniform load over a disc.
-
-    Gauss-Legendre in r^2 (area-uniform rings) x equally spaced angles; points that fall off
-    the plate are dropped and the weights renormalised (the load stays 1 N in total).
-    radius 0 gives the point itself.
-    """
-    center = np.asarray(center, dtype=float).reshape(2)
-    if radius == 0.0:
-        return center[None, :], np.ones(1)
-    g, gw = np.polynomial.legendre.leggauss(DISC_RINGS)
-    rings = radius * np.sqrt(0.5 * (g + 1.0))
-    angles = 2.0 * np.pi * (np.arange(DISC_SPOKES) + 0.5) / DISC_SPOKES
-    r, th = np.meshgrid(rings, angles, indexing="ij")
-    pts = center + np.column_stack([(r * np.cos(th)).ravel(), (r * np.sin(th)).ravel()])
-    w = np.repeat(gw, DISC_SPOKES)
-    inside = (np.abs(pts[:, 0]) <= 0.5 * plate.size_x) & (np.abs(pts[:, 1]) <= 0.5 * plate.size_y)
-    return pts[inside], w[inside] / w[inside].sum()
 
 
 def check_points(plate: Plate, points, field: str = "points") -> np.ndarray:
@@ -127,6 +107,12 @@ class PlateModel:
             f = self.load_vector(p, contact_radius)
             out[i] = f @ self.solver().solve(f)
         return out
+
+    def static_deflection(self, load_point, points, contact_radius: float = 0.0) -> np.ndarray:
+        """(p,) static deflection (m/N) at ``points`` under a unit load at ``load_point``
+        (spread over a disc of ``contact_radius`` m): the static cross compliance."""
+        f = self.load_vector(load_point, contact_radius)
+        return np.asarray(self.deflection_operator(points) @ self.solver().solve(f)).ravel()
 
 
 def resolve_mesh(plate: Plate, mesh, divisions) -> MeshTri:

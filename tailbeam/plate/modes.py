@@ -207,7 +207,11 @@ def _make_basis(
         def static_compliance_at(points, contact_radius=0.0):
             return basis.fe_model().static_compliance(points, contact_radius)
 
+        def static_deflection_at(load_point, points, contact_radius=0.0):
+            return basis.fe_model().static_deflection(load_point, points, contact_radius)
+
         object.__setattr__(basis, "static_compliance_at", static_compliance_at)
+        object.__setattr__(basis, "static_deflection_at", static_deflection_at)
     return basis
 
 

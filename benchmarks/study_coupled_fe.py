@@ -1,0 +1,219 @@
+"""Convergence of the modal coupled solver to the full-FE reference as the band grows.
+
+    python benchmarks/study_coupled_fe.py --out DIR [--full] [--theory kirchhoff|mindlin|both]
+
+One impact (sandstone, 30 mm, 1 m/s at (0.05, 0.03) m on the 0.6 m SSSS steel plate), the
+sensor 7 cm away at (0.05, 0.10) m. Truth: tailbeam.coupled.fe_reference on the SAME mesh and
+element (every DOF, Newmark average acceleration at 1e-7 s, the contact law implicit each step;
+its own step study is printed). The modal solver runs at bands 10-40 kHz, 800 steps per contact
+(so the time step stays below the truncation error), plate damping 0, with each correction on
+and off:
+
+- "no residual": kept modes only;
+- "residual (before)": the residual compliance as before issue 9: static compliance over the
+  Hertz disc minus the kept modes at the point (inconsistent load models);
+- "residual": one load model for both parts (point for Kirchhoff, Hertz disc for Mindlin);
+- "residual + sensor QS": also the truncated modes' quasi-static response at the sensor.
+
+Errors: the largest relative error of restitution, peak force, duration and maximum
+penetration ("contact"), and the relative L2 error of the 0-10 kHz sensor acceleration over the
+first 3 ms ("sensor"). Default meshes: Argyris 8x8 and Mindlin P4 6x6 (a few minutes);
+--full uses the default meshes of a 20 kHz band (Argyris 23x23: ~15 min for the reference;
+Mindlin 25x25, 30k DOFs: over an hour). Writes study.csv, study.md and study.png.
+"""
+
+import argparse
+import csv
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from tailbeam.bodies import Ball, Plate
+from tailbeam.contact_law import ball_plate_law
+from tailbeam.coupled import records
+from tailbeam.coupled.fe_compare import Case, modal_errors, observed_order
+from tailbeam.coupled.fe_reference import fe_time_step_study
+from tailbeam.hertz import hertz_max_penetration
+from tailbeam.materials import CARBON_STEEL, SANDSTONE
+from tailbeam.plate import assemble_plate, compute_modes
+from tailbeam.plate.resolution import resolve
+
+R = 0.03
+IMPACT, SENSOR = (0.05, 0.03), (0.05, 0.10)
+BANDS = (10000.0, 14000.0, 20000.0, 28000.0, 40000.0)
+TEST_MESHES = {"kirchhoff": 8, "mindlin": 6}
+VARIANTS = ("no residual", "residual (before)", "residual", "residual + sensor QS")
+
+
+def _divisions(theory, full):
+    if not full:
+        return TEST_MESHES[theory]
+    res = resolve(Plate(), theory=theory, fmax_hz=20000.0, count=None, accuracy=1e-3,
+                  user_mesh=False, divisions=None)  # fmt: skip
+    return res.divisions
+
+
+def _before(basis, ball, law):
+    """The pre-issue-9 residual: static compliance over the Hertz disc (at the impact speed)
+    minus the kept modes at the contact point."""
+    radius = math.sqrt(R * hertz_max_penetration(ball.mass, 1.0, law.stiffness, law.exponent))
+
+    def residual_compliance(points, _radius=0.0):
+        full = np.asarray(basis.static_compliance_at(np.atleast_2d(points), radius))
+        kept = np.sum(basis.deflection(points) ** 2 / basis.omega**2, axis=1)
+        return np.maximum(full - kept, 0.0)
+
+    object.__setattr__(basis, "residual_compliance", residual_compliance)
+    records._COMPLIANCE_CACHE.pop(basis, None)
+    return basis
+
+
+def study_theory(theory, full, dt, steps, bands=BANDS):
+    """Rows of (theory, band, n_modes, variant, contact error, sensor error) for one theory."""
+    divisions = _divisions(theory, full)
+    plate = Plate()
+    model = assemble_plate(plate, "SSSS", theory=theory, divisions=divisions)
+    ball = Ball("b", SANDSTONE, R, (*IMPACT, R + 1e-5), (0.0, 0.0, -1.0))
+    law = ball_plate_law(SANDSTONE, R, CARBON_STEEL)
+    case = Case(model, ball, law, SENSOR)
+    print(f"{theory}: {divisions} divisions, {model.n_dofs} DOFs", flush=True)
+    steps_study = fe_time_step_study(model, ball, law, 5e-4, [4 * dt, 2 * dt, dt],
+                                     load_radius=case.load_radius, max_work=1e14)  # fmt: skip
+    print(f"  reference step study (orders, error estimate at dt = {dt:g} s):",
+          {k: (round(v[0], 2), f"{steps_study['error_estimate'][k]:.1e}")
+           for k, v in steps_study["orders"].items()}, flush=True)  # fmt: skip
+    t0 = time.perf_counter()
+    ref = case.reference(dt, max_work=1e14)
+    print(f"  reference: {time.perf_counter() - t0:.0f} s", flush=True)
+    rows = []
+    for band in bands:
+
+        def basis(band=band):
+            return compute_modes(plate, "SSSS", theory=theory, divisions=divisions, fmax_hz=band)
+
+        none = modal_errors(case, basis(), ref, residual_flexibility=False, steps_per_contact=steps)
+        old = modal_errors(case, _before(basis(), ball, law), ref, steps_per_contact=steps)
+        new = modal_errors(case, basis(), ref, steps_per_contact=steps)
+        default = modal_errors(case, basis(), ref)  # 200 steps per contact, as shipped
+        n = new["n_modes"]
+        rows += [
+            (theory, band, n, VARIANTS[0], none["contact"], none["sensor_no_qs"]),
+            (theory, band, n, VARIANTS[1], old["contact"], old["sensor_no_qs"]),
+            (theory, band, n, VARIANTS[2], new["contact"], new["sensor_no_qs"]),
+            (theory, band, n, VARIANTS[3], new["contact"], new["sensor"]),
+            (theory, band, n, "default (200 steps/contact)", default["contact"],
+             default["sensor"]),
+        ]  # fmt: skip
+        print(f"  {band:7.0f} Hz {n:4d} modes: contact {none['contact']:.2e} / "
+              f"{old['contact']:.2e} / {new['contact']:.2e}; sensor {none['sensor_no_qs']:.2e}"
+              f" / {new['sensor_no_qs']:.2e} / {new['sensor']:.2e}", flush=True)  # fmt: skip
+    return rows, divisions, model.n_dofs, steps_study
+
+
+def _orders(rows):
+    out = {}
+    for theory in sorted({r[0] for r in rows}):
+        for variant in VARIANTS:
+            sel = [r for r in rows if r[0] == theory and r[3] == variant and r[1] >= 14000.0]
+            bands = [r[1] for r in sel]
+            out[theory, variant] = (observed_order(bands, [r[4] for r in sel]),
+                                    observed_order(bands, [r[5] for r in sel]))  # fmt: skip
+    return out
+
+
+def write_table(rows, meta, out: Path):
+    with open(out / "study.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["theory", "band_hz", "n_modes", "variant", "contact_err", "sensor_err"])
+        w.writerows(rows)
+    orders = _orders(rows)
+    lines = ["| theory | band (kHz) | modes | variant | contact error | sensor error (0-10 kHz) |",
+             "|---|---|---|---|---|---|"]  # fmt: skip
+    for r in rows:
+        lines.append(f"| {r[0]} | {r[1] / 1000:g} | {r[2]} | {r[3]} | {r[4]:.1e} | {r[5]:.1e} |")
+    lines += ["", "Observed order in the band (error ~ band^-order, fit over 14-40 kHz):", "",
+              "| theory | variant | contact | sensor |", "|---|---|---|---|"]  # fmt: skip
+    for (theory, variant), (oc, os_) in orders.items():
+        lines.append(f"| {theory} | {variant} | {oc:.1f} | {os_:.1f} |")
+    lines += ["", *meta]
+    (out / "study.md").write_text("\n".join(lines) + "\n")
+    return "\n".join(lines)
+
+
+def plot(rows, out: Path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    theories = sorted({r[0] for r in rows})
+    fig, axes = plt.subplots(len(theories), 2, figsize=(10, 3.8 * len(theories)), squeeze=False)
+    styles = {VARIANTS[0]: "o:", VARIANTS[1]: "s--", VARIANTS[2]: "^-", VARIANTS[3]: "D-"}
+    for i, theory in enumerate(theories):
+        for j, (col, what) in enumerate(((4, "contact (max of 4 quantities)"),
+                                         (5, "sensor, 0-10 kHz, first 3 ms"))):  # fmt: skip
+            ax = axes[i, j]
+            for variant, style in styles.items():
+                if j == 0 and variant == VARIANTS[3]:
+                    continue  # the sensor correction does not change the contact
+                sel = [r for r in rows if r[0] == theory and r[3] == variant]
+                ax.loglog([r[1] / 1000 for r in sel], [r[col] for r in sel], style,
+                          label=variant)  # fmt: skip
+            if j == 0:
+                ax.axhline(2e-5, color="grey", lw=0.8)
+                ax.text(10.2, 2.2e-5, "2e-5", color="grey", fontsize=8)
+            else:
+                ax.axhline(1.5e-3, color="grey", lw=0.8)
+                ax.text(10.2, 1.6e-3, "1.5e-3", color="grey", fontsize=8)
+            ax.set_xlabel("modal band (kHz)")
+            ax.set_ylabel("relative error vs full FE")
+            ax.set_title(f"{theory}: {what}", fontsize=10)
+            ticks = sorted({r[1] / 1000 for r in rows})
+            ax.set_xticks(ticks, labels=[f"{b:g}" for b in ticks])
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out / "study.png", dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--full", action="store_true", help="default meshes of a 20 kHz band")
+    ap.add_argument("--theory", choices=("kirchhoff", "mindlin", "both"), default="both")
+    ap.add_argument("--dt", type=float, default=1e-7, help="reference step, s")
+    ap.add_argument("--steps", type=int, default=800, help="modal steps per contact")
+    ap.add_argument("--bands", type=float, nargs="+", default=BANDS, help="modal bands, Hz")
+    ap.add_argument("--replot", action="store_true", help="redraw study.png from study.csv")
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    if args.replot:
+        with open(out / "study.csv") as fh:
+            rows = [(r[0], float(r[1]), int(r[2]), r[3], float(r[4]), float(r[5]))
+                    for r in list(csv.reader(fh))[1:]]  # fmt: skip
+        plot(rows, out)
+        return rows
+    theories = ("kirchhoff", "mindlin") if args.theory == "both" else (args.theory,)
+    rows, meta = [], []
+    for theory in theories:
+        r, divisions, n_dofs, st = study_theory(theory, args.full, args.dt, args.steps, args.bands)
+        rows += r
+        est = max(st["error_estimate"].values())
+        order = min(min(v) for v in st["orders"].values())
+        meta.append(f"{theory}: {divisions}x{divisions} mesh, {n_dofs} DOFs; reference dt "
+                    f"{args.dt:g} s (step study: order >= {order:.2f}, contact error "
+                    f"<= {est:.0e}); modal {args.steps} steps/contact.")  # fmt: skip
+    print(write_table(rows, meta, out))
+    plot(rows, out)
+    return rows
+
+
+if __name__ == "__main__":
+    sys.exit(0 if main() else 1)
