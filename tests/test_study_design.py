@@ -153,13 +153,13 @@ def test_core_imports_and_cli_work_without_the_study_extra():
 
 
 def test_example_sweep_file_expands_to_its_stated_cases():
-    """examples/sweep_single_impacts.toml (the README's example) says 2 x 20 = 40 cases; every
+    """examples/sweeps/single_impacts.toml (the README's example) says 2 x 20 = 40 cases; every
     radius lies in its log-uniform range and the drop gap follows the radius."""
     from pathlib import Path
 
     from tailbeam.study.design import load_sweep
 
-    path = Path(__file__).resolve().parents[1] / "examples" / "sweep_single_impacts.toml"
+    path = Path(__file__).resolve().parents[1] / "examples" / "sweeps" / "single_impacts.toml"
     cases = expand(load_sweep(path))
     assert len(cases) == 40
     materials = sorted(c.params["balls.rock.material"] for c in cases)

@@ -24,6 +24,7 @@ duration = 0.01
 [plate]
 model = "modal"
 fmax = 3000.0
+size = [0.6, 0.6, 0.0099]  # a plate no other test uses: its basis is this module's own
 [[balls]]
 name = "rock"
 material = "coal"
