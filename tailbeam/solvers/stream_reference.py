@@ -53,6 +53,7 @@ NODES = 15  # Chebyshev points per step: exact for the degree-14 squared distanc
 _U = -np.cos(np.pi * np.arange(NODES) / (NODES - 1))  # increasing, -1 .. 1
 _S = 0.5 * (_U + 1.0)  # the same points as fractions of the step
 _VINV = np.linalg.inv(cheb.chebvander(_U, NODES - 1))
+SAME_TIME = 1e-9  # events closer than this (fraction of a step) are simultaneous
 FRESH_S = 1e-10  # roots closer than this (fraction of a step) to a restart are the restart's
 
 
@@ -76,6 +77,16 @@ class _Pair:
     def kinked(self) -> bool:
         """Whether the law has a STEP kink at delta = d (it does only with damping)."""
         return self.law.damping > 0.0
+
+
+@dataclass(frozen=True)
+class _PairIndex:
+    """Local indices (li, lj; lj unused where is_plate) and radius sums (m) of pairs."""
+
+    li: np.ndarray
+    lj: np.ndarray
+    is_plate: np.ndarray
+    radius_sum: np.ndarray
 
 
 @dataclass
@@ -164,17 +175,24 @@ class _Reference:
         loc[self.active] = np.arange(len(self.active))
         return loc
 
-    def kinematics(self, pairs, x, v):
-        """Kinematics of ``pairs`` at positions/velocities x, v of shape (..., n, 3)."""
+    def index(self, pairs) -> "_PairIndex":
+        """Local ball indices and radius sums of ``pairs`` (valid until a ball is dropped)."""
         loc = self.local()
         li = loc[[p.i for p in pairs]]
         lj = loc[[max(p.j, 0) for p in pairs]]
-        is_plate = np.array([p.j < 0 for p in pairs])
+        is_plate = np.array([p.j < 0 for p in pairs], dtype=bool)
+        return _PairIndex(li, lj, is_plate, np.array([p.radius_sum for p in pairs]))
+
+    def kinematics(self, pairs, x, v):
+        """Kinematics of ``pairs`` (a list or its ``index``) at positions/velocities x, v of
+        shape (..., n, 3); also returns the local indices and the plate flags."""
+        ix = pairs if isinstance(pairs, _PairIndex) else self.index(pairs)
+        li, lj, is_plate = ix.li, ix.lj, ix.is_plate
         xi, vi = x[..., li, :], v[..., li, :]
         foot = plate_foot(xi.reshape(-1, 3)).reshape(xi.shape)
         xj = np.where(is_plate[:, None], foot, x[..., lj, :])
         vj = np.where(is_plate[:, None], 0.0, v[..., lj, :])
-        rsum = np.broadcast_to(np.array([p.radius_sum for p in pairs]), xi.shape[:-1])
+        rsum = np.broadcast_to(ix.radius_sum, xi.shape[:-1])
         kin = pair_kinematics(*(a.reshape(-1, 3) for a in (xi, vi, xj, vj)), rsum.reshape(-1))
         return kin, li, lj, is_plate
 
@@ -185,12 +203,13 @@ class _Reference:
         ramp = np.array([p.ramp for p in pairs], dtype=bool)
         clamped = np.array([p.clamped for p in pairs], dtype=bool)
         m = self.mass[self.active]
+        ix = self.index(pairs)
 
         def rhs(t, y):
             x, v = self.split(y)
             acc = np.tile(self.g, (len(m), 1))
             if pairs:
-                kin, li, lj, is_plate = self.kinematics(pairs, x, v)
+                kin, li, lj, is_plate = self.kinematics(ix, x, v)
                 f = impact_force_in_region(kin.penetration, kin.rate, laws, ramp, clamped)
                 fn = f[:, None] * kin.normal
                 np.add.at(acc, li, fn / m[li, None])
@@ -210,9 +229,8 @@ class _Reference:
             if solver.status == "finished":
                 if pending is None:
                     break
-                key, t_e = pending
-                h0 = self.apply(key, solver.t, solver.y)
-                fresh, pending, t_bound = {key}, None, duration
+                fresh, h0 = self.finish_redo(pending[0], solver.t, solver.y)
+                pending, t_bound = None, duration
                 solver = self.new_solver(self.t, self.y, t_bound, h0)
                 continue
             t0, y0 = solver.t, solver.y.copy()
@@ -226,24 +244,37 @@ class _Reference:
                     f"t = {t0:.6g} s; raise max_steps or shorten the duration"
                 )
             dense, t1 = solver.dense_output(), solver.t
-            skip = {pending[0]} if pending else set()
-            found = self.detect(dense, t0, t1, fresh, skip)
+            found = self.detect(dense, t0, t1, fresh)
+            if found is not None and pending and found[1] >= pending[1] - SAME_TIME * (t1 - t0):
+                found = None  # (about) simultaneous with the pending event: taken after it
             if found is None:
                 self.accept(dense, t0, t1)
                 self.record_step(t1, solver.y)
                 fresh = set() if t1 > t0 else fresh
                 continue
-            key, t_e = found
-            if t_e <= t0:  # on the wrong side already at the restart: apply it there
-                h0 = self.apply(key, t0, y0)
-                fresh = fresh | {key}
+            row, t_e = found
+            if t_e <= t0 + 4.0 * np.spacing(t0):  # at the restart (to round-off): apply there
+                h0 = self.apply(row[0], t0, y0)
+                fresh = fresh | {row[0]}
                 pending, t_bound = None, duration
             else:  # redo the step so that it ends exactly at the event
                 self.t, self.y = t0, y0
-                pending, t_bound, h0 = (key, t_e), t_e, t_e - t0
+                pending, t_bound, h0 = (row, t_e), t_e, t_e - t0
             solver = self.new_solver(self.t, self.y, t_bound, h0)
         self.finish()
         return self.result(duration)
+
+    def finish_redo(self, row, t, y):
+        """At the end of a redone step: apply the event if its row is within its dead band
+        of the crossing; otherwise (the discarded step, which straddled the kink, placed the
+        root early) go on from here: the next step finds it again, closer. Returns the
+        fresh set and the next first step."""
+        x, v = self.split(y)
+        key, sign, _, band = row
+        if sign * self.row_values([row], x[None], v[None])[0, 0] <= band:
+            return {key}, self.apply(key, t, y)
+        self.t, self.y = t, y
+        return set(), None
 
     def new_solver(self, t, y, t_bound, h0):
         self.t, self.y = t, y
@@ -255,20 +286,28 @@ class _Reference:
 
     # --- events ---------------------------------------------------------------------------
     def rows(self):
-        """Watched functions: (key, expected sign, polynomial?) in a fixed order."""
+        """Watched functions: (key, expected sign, polynomial?, dead band) in a fixed order.
+
+        A row's event is its value crossing the dead band on the far side of zero (squared
+        distances: 1e-12 (r_i + r_j)^2, i.e. a penetration of ~5e-13 (r_i + r_j), ~1e-14 m;
+        edges 1e-13 m; clamp indicator 1e-10): round-off at a grazing touch (two balls
+        parting at zero normal speed) then does not start and end contacts over and over.
+        """
         rows = []
         for pk, p in self.pairs.items():
+            band = 1e-12 * p.radius_sum**2
             if not p.in_contact:
-                rows.append(((EventKind.CONTACT_START, pk), 1.0, True))
+                rows.append(((EventKind.CONTACT_START, pk), 1.0, True, band))
                 continue
-            rows.append(((EventKind.CONTACT_END, pk), -1.0, True))
+            rows.append(((EventKind.CONTACT_END, pk), -1.0, True, band))
             if p.kinked:
-                rows.append(((EventKind.FULL_DAMPING, pk), 1.0 if p.ramp else -1.0, True))
+                rows.append(((EventKind.FULL_DAMPING, pk), 1.0 if p.ramp else -1.0, True, band))
             if p.kinked and p.law.clamp:
-                rows.append(((EventKind.CLAMP_ON, pk), -1.0 if p.clamped else 1.0, False))
+                sign = -1.0 if p.clamped else 1.0
+                rows.append(((EventKind.CLAMP_ON, pk), sign, False, 1e-10))
         for b in self.active:
             for e in range(len(EDGES)):
-                rows.append(((EventKind.LEAVE, (b, e)), 1.0, True))
+                rows.append(((EventKind.LEAVE, (b, e)), 1.0, True, 1e-13))
         return rows
 
     def row_values(self, rows, x, v):
@@ -283,7 +322,7 @@ class _Reference:
             rate = kin.rate.reshape(x.shape[0], len(pairs)).T
         loc = self.local()
         edges = self.incline.edge_distances(x[..., :2])  # (K, n, 4)
-        for r, ((kind, key), _, _) in enumerate(rows):
+        for r, ((kind, key), *_) in enumerate(rows):
             if kind == EventKind.LEAVE:
                 out[r] = edges[:, loc[key[0]], key[1]]
                 continue
@@ -306,46 +345,54 @@ class _Reference:
         n = len(self.active)
         return ys[:, : 3 * n].reshape(-1, n, 3), ys[:, 3 * n :].reshape(-1, n, 3)
 
-    def detect(self, dense, t0, t1, fresh, skip):
-        """Earliest (key, time) of an event on [t0, t1], or None."""
-        rows = [r for r in self.rows() if r[0] not in skip]
+    def detect(self, dense, t0, t1, fresh):
+        """Earliest (row, time) of an event on [t0, t1], or None."""
+        rows = self.rows()
         if not rows or t1 <= t0:
             return None
         x, v = self.states_at(dense, t0 + _S * (t1 - t0))
         values = self.row_values(rows, x, v)
-        signs = np.array([r[1] for r in rows])
-        coef = values @ _VINV.T  # Chebyshev coefficients of every row
+        # g = sign x value + band: positive on the row's side, its event where g < 0
+        g = (
+            np.array([r[1] for r in rows])[:, None] * values
+            + np.array([r[3] for r in rows])[:, None]
+        )
+        coef = g @ _VINV.T  # Chebyshev coefficients of every row
         bound = np.sum(np.abs(coef[:, 1:]), axis=1) * (1.0 + 1e-12)
-        certified = (signs * coef[:, 0] > bound) & np.array([r[2] for r in rows])
+        certified = (coef[:, 0] > bound) & np.array([r[2] for r in rows])
         best = (math.inf, None)
         for r in np.flatnonzero(~certified):
-            key, sign, poly = rows[r]
+            key, _, poly, _ = rows[r]
             is_fresh = _same_switch(key, fresh)
             if poly:
-                s = _first_poly_crossing(coef[r], values[r], sign, is_fresh)
+                s = _first_poly_crossing(coef[r], g[r], is_fresh)
             else:
-                s = self.first_sampled_crossing(rows[r], values[r], dense, t0, t1, is_fresh)
+                s = self.first_sampled_crossing(rows[r], g[r], dense, t0, t1, is_fresh)
             if s < best[0]:
-                best = (s, key)
+                best = (s, rows[r])
         if best[1] is None:
             return None
         return best[1], t0 + best[0] * (t1 - t0)
 
     def first_sampled_crossing(self, row, values, dense, t0, t1, is_fresh):
-        key, sign, _ = row
-        wrong = np.flatnonzero(values * sign < 0.0)
-        wrong = wrong[wrong > 0] if is_fresh else wrong
-        if wrong.size == 0:
-            return math.inf
-        k = wrong[0]
-        if k == 0:
+        """First s where a sampled (non-polynomial) row leaves its side: a node on the wrong
+        side right after one on the right side, bracketed by brentq. A row an event just sat
+        on (``is_fresh``) may start on the wrong side by round-off (its root was located on
+        the discarded step's interpolant): only a right-to-wrong change counts for it."""
+        key, sign, _, band = row
+        right = values > 0.0
+        if not is_fresh and not right[0]:
             return 0.0
+        change = np.flatnonzero(right[:-1] & ~right[1:])
+        if change.size == 0:
+            return math.inf
+        k = int(change[0]) + 1
 
         def f(s):
             x, v = self.states_at(dense, np.array([t0 + s * (t1 - t0)]))
-            return self.row_values([row], x, v)[0, 0]
+            return sign * self.row_values([row], x, v)[0, 0] + band
 
-        return brentq(f, _S[k - 1], _S[k], xtol=1e-15, rtol=4e-16)
+        return brentq(f, _S[k - 1], _S[k], xtol=1e-15, rtol=1e-15)
 
     def apply(self, key, t, y):
         """Apply event ``key`` at time t with state y; returns the next first step (s)."""
@@ -363,7 +410,8 @@ class _Reference:
             return self.first_contact_step(p, kin.rate[0])
         if kind == EventKind.CONTACT_END:
             self.close_contact(p, t, kin, v, li[0], lj[0], "separated")
-        elif kind == EventKind.FULL_DAMPING:
+            return None
+        if kind == EventKind.FULL_DAMPING:
             p.ramp = not p.ramp
         else:
             p.clamped = not p.clamped
@@ -445,11 +493,16 @@ class _Reference:
         if not pairs or t1 <= t0:
             return
         force, delta = self.pair_forces(pairs, *self.states_at(dense, t0 + _S * (t1 - t0)))
+        # Refined only where the node maximum comes within 1 % of the record so far: between
+        # nodes the interpolant cannot exceed them by more (a step resolved to rtol 1e-12
+        # spans ~(1e-12)^(1/8) of the force's time scale; the overshoot is ~1e-6).
         for q, p in enumerate(pairs):
-            s_peak, peak = _interpolant_max(force[q])
-            if peak > p.peak:
-                p.peak, p.t_peak = peak, t0 + s_peak * (t1 - t0)
-            p.pen = max(p.pen, _interpolant_max(delta[q])[1])
+            if force[q].max() >= 0.99 * p.peak:
+                s_peak, peak = _interpolant_max(force[q])
+                if peak > p.peak:
+                    p.peak, p.t_peak = peak, t0 + s_peak * (t1 - t0)
+            if delta[q].max() >= 0.99 * p.pen:
+                p.pen = max(p.pen, _interpolant_max(delta[q])[1])
 
     def pair_forces(self, pairs, x, v):
         """Force (N) and penetration (m) of ``pairs`` at states x, v (K, n, 3): (P, K) each."""
@@ -516,11 +569,11 @@ def _same_switch(key, fresh) -> bool:
     return False
 
 
-def _first_poly_crossing(c, values, sign, is_fresh) -> float:
-    """First fraction s in [0, 1] of the step where the degree-14 polynomial with Chebyshev
-    coefficients ``c`` (``values`` at the Chebyshev points) leaves the side ``sign``; inf if
-    none. (Rows with sign c0 > sum |c_k| are certified not to cross and never get here.)"""
-    if not is_fresh and sign * values[0] < 0.0:
+def _first_poly_crossing(c, values, is_fresh) -> float:
+    """First fraction s in [0, 1] of the step where the degree-14 polynomial g with Chebyshev
+    coefficients ``c`` (``values`` at the Chebyshev points) becomes negative; inf if none.
+    (Rows with c0 > sum |c_k| are certified positive and never get here.)"""
+    if not is_fresh and values[0] < 0.0:
         return 0.0
     dc = cheb.chebder(c)
     best = math.inf
@@ -536,7 +589,7 @@ def _first_poly_crossing(c, values, sign, is_fresh) -> float:
         s = 0.5 * (u + 1.0)
         if is_fresh and s < FRESH_S:
             continue
-        if sign * cheb.chebval(u, dc) < 0.0 and s < best:  # crossing away from ``sign``
+        if cheb.chebval(u, dc) < 0.0 and s < best:  # a crossing downwards
             best = s
     return best
 
