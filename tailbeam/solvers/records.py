@@ -19,6 +19,7 @@ class EventKind(str, Enum):
     CLAMP_ON = "clamp_on"
     CLAMP_OFF = "clamp_off"
     LEAVE = "leave"  # a ball's centre passed an edge of the plate
+    RELEASE = "release"  # a ball entered the scene (a stream particle's release time)
 
 
 @dataclass

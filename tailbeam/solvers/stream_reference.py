@@ -131,6 +131,7 @@ def simulate_stream_reference(
     exponent: float = HERTZ_EXPONENT,
     rtol: float = 1e-12,
     max_steps: int = 200_000,
+    release_times=None,
 ) -> StreamReferenceResult:
     """Integrate ``balls`` (``tailbeam.Ball``, positions and velocities in the plate frame)
     on ``incline`` for ``duration`` s; see the module docstring.
@@ -138,31 +139,39 @@ def simulate_stream_reference(
     damping c (N s/m), penetration d (m), clamp, exponent e: the IMPACT parameters of every
     pair (stiffness from Hertz). rtol: DOP853's relative tolerance (atol = rtol x 1 mm on
     positions, rtol x 1 m/s on velocities). max_steps bounds the work (WorkLimitError).
+    release_times (s, one per ball, default all 0): a ball enters the scene at its time, at
+    its given position and velocity (event ``release``; the energy series jumps there).
     """
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-3:
         raise InputError("rtol", f"must lie in [1e-14, 1e-3], got {rtol!r}")
     options = dict(exponent=exponent, damping=damping, penetration=penetration, clamp=clamp)
-    sim = _Reference(list(balls), incline, options, rtol, max_steps)
+    balls = list(balls)
+    release = _release_times(release_times, len(balls))
+    sim = _Reference(balls, incline, options, rtol, max_steps, release)
     return sim.run(duration)
 
 
 class _Reference:
-    def __init__(self, balls, incline, options, rtol, max_steps):
+    def __init__(self, balls, incline, options, rtol, max_steps, release):
         _check_balls(balls, incline)
         self.balls, self.incline, self.rtol, self.max_steps = balls, incline, rtol, max_steps
         self.g = incline.gravity_vector
         self.mass = np.array([b.mass for b in balls])
-        self.active = list(range(len(balls)))
-        self.pairs = _make_pairs(balls, incline, options)
+        self.options = options
+        self.active = [i for i in range(len(balls)) if release[i] <= 0.0]
+        self.waiting = sorted((float(release[i]), i) for i in range(len(balls)) if release[i] > 0)
+        self.pairs = {}
+        for i in self.active:
+            self.add_pairs(i)
         self.contacts, self.leaves, self.events = [], [], []
         self.times, self.energy, self.states = [], [], []
         self.steps = 0
-        pos = np.array([b.position for b in balls], dtype=float)
-        vel = np.array([b.velocity for b in balls], dtype=float)
+        pos = np.array([balls[i].position for i in self.active], dtype=float).reshape(-1, 3)
+        vel = np.array([balls[i].velocity for i in self.active], dtype=float).reshape(-1, 3)
         self.y = np.concatenate([pos.ravel(), vel.ravel()])
         self.t = 0.0
-        self._start_touching()
+        self.touch(list(self.pairs.values()), 0.0)
 
     # --- state layout ---------------------------------------------------------------------
     def split(self, y):
@@ -222,15 +231,18 @@ class _Reference:
     # --- main loop ------------------------------------------------------------------------
     def run(self, duration):
         fresh, pending, h0 = set(), None, None
-        t_bound = duration
+        t_bound = self.next_stop(duration)
         solver = self.new_solver(self.t, self.y, t_bound, h0)
         self.record_step(self.t, self.y)
         while True:
             if solver.status == "finished":
-                if pending is None:
+                if pending is None and solver.t >= duration:
                     break
-                fresh, h0 = self.finish_redo(pending[0], solver.t, solver.y)
-                pending, t_bound = None, duration
+                if pending is None:  # a release time
+                    fresh, h0 = set(), self.release_due(solver.t, solver.y)
+                else:
+                    fresh, h0 = self.finish_redo(pending[0], solver.t, solver.y)
+                pending, t_bound = None, self.next_stop(duration)
                 solver = self.new_solver(self.t, self.y, t_bound, h0)
                 continue
             t0, y0 = solver.t, solver.y.copy()
@@ -256,7 +268,7 @@ class _Reference:
             if t_e <= t0 + 4.0 * np.spacing(t0):  # at the restart (to round-off): apply there
                 h0 = self.apply(row[0], t0, y0)
                 fresh = fresh | {row[0]}
-                pending, t_bound = None, duration
+                pending, t_bound = None, self.next_stop(duration)
             else:  # redo the step so that it ends exactly at the event
                 self.t, self.y = t0, y0
                 pending, t_bound, h0 = (row, t_e), t_e, t_e - t0
@@ -475,13 +487,49 @@ class _Reference:
         self.active = [self.active[q] for q in keep]
         self.y = np.concatenate([x[keep].ravel(), v[keep].ravel()])
 
-    def _start_touching(self):
-        """Pairs overlapping at t = 0 start in contact (e.g. a ball at its static penetration)."""
+    def next_stop(self, duration):
+        """Where the integration must stop next: the next release time or the end."""
+        return min(duration, self.waiting[0][0]) if self.waiting else duration
+
+    def release_due(self, t, y):
+        """Add the balls whose release time is t (their given state), with their pairs."""
+        self.t, self.y = t, y
+        x, v = self.split(y)
+        new = []
+        while self.waiting and self.waiting[0][0] <= t:
+            _, i = self.waiting.pop(0)
+            ball = self.balls[i]
+            self.active.append(i)
+            x = np.vstack([x, ball.position])
+            v = np.vstack([v, ball.velocity])
+            new.extend(self.add_pairs(i))
+            self.events.append((t, EventKind.RELEASE, ball.name, ""))
+        self.y = np.concatenate([x.ravel(), v.ravel()])
+        self.touch(new, t)
+        return None
+
+    def add_pairs(self, i):
+        """Create the pairs of ball i with the plate and with every other active ball."""
+        a, made = self.balls[i], []
+        law = ball_plate_law(a.material, a.radius, self.incline.plate.material, **self.options)
+        made.append(self.pairs.setdefault((i, -1), _Pair(i, -1, law, a.radius)))
+        for j in self.active:
+            if j != i:
+                lo, hi = min(i, j), max(i, j)
+                b, c = self.balls[lo], self.balls[hi]
+                law = ball_ball_law(b.material, b.radius, c.material, c.radius, **self.options)
+                pair = _Pair(lo, hi, law, b.radius + c.radius)
+                made.append(self.pairs.setdefault((lo, hi), pair))
+        return made
+
+    def touch(self, pairs, t):
+        """Pairs overlapping when they appear start in contact (e.g. a ball placed at its
+        static penetration)."""
         x, v = self.split(self.y)
-        for p in self.pairs.values():
+        for p in pairs:
             kin, li, lj, _ = self.kinematics([p], x, v)
             if kin.penetration[0] > 0.0:
-                self.open_contact(p, 0.0, kin, x[li[0]], v, li[0], lj[0])
+                self.open_contact(p, t, kin, x[li[0]], v, li[0], lj[0])
                 p.ramp = bool(kin.penetration[0] < p.law.penetration) or not p.kinked
                 ind = clamp_indicator(kin.penetration[0], kin.rate[0], p.law, p.ramp)
                 p.clamped = bool(p.law.clamp and p.kinked and ind < 0.0)
@@ -615,18 +663,13 @@ def _law_table(pairs) -> _Laws:
                    for a in ("stiffness", "exponent", "damping", "penetration")))  # fmt: skip
 
 
-def _make_pairs(balls, incline, options) -> dict:
-    """Every ball-ball pair (i < j) and every ball-plate pair (j = -1), with its law."""
-    plate_material = incline.plate.material
-    pairs = {}
-    for i, a in enumerate(balls):
-        law = ball_plate_law(a.material, a.radius, plate_material, **options)
-        pairs[(i, -1)] = _Pair(i, -1, law, a.radius)
-        for j in range(i + 1, len(balls)):
-            b = balls[j]
-            law = ball_ball_law(a.material, a.radius, b.material, b.radius, **options)
-            pairs[(i, j)] = _Pair(i, j, law, a.radius + b.radius)
-    return pairs
+def _release_times(release_times, n):
+    if release_times is None:
+        return np.zeros(n)
+    times = np.asarray(release_times, dtype=float)
+    if times.shape != (n,) or not np.all(np.isfinite(times)) or np.any(times < 0.0):
+        raise InputError("release_times", f"must be {n} finite times >= 0 s (one per ball)")
+    return times
 
 
 def _check_balls(balls, incline):
