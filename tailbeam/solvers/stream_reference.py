@@ -16,21 +16,22 @@ step through its ``OdeSolver`` class so that every step can be checked for conta
   to end exactly at the event, where the integration restarts with the new region, so no
   accepted step straddles a kink.
 
-Event search. DOP853's dense output is a polynomial of degree 7 in time on each step, so the
-squared distance of two centres (and the plate gap, the edge distances) is a polynomial of
-degree <= 14 there. It is interpolated exactly at 15 Chebyshev points; a row whose Chebyshev
-coefficients satisfy |c0| > sum |c_k| cannot change sign on the step (certified: no contact is
-missed, however short the step's approach and retreat), the others are root-found
-(``chebroots``, Newton-polished). The clamp indicator (not polynomial) is sampled at the 15
-points and bracketed with ``brentq``. Peak force and maximum penetration: the maximum of
-their Chebyshev interpolant on each step (node values and roots of its derivative).
+Event search (``tailbeam.solvers.step_events``). DOP853's dense output is a polynomial of
+degree 7 in time on each step, so the squared distance of two centres (and the plate gap,
+the edge distances) is a polynomial of degree <= 14 there, interpolated exactly at 15
+Chebyshev points and certified or root-found: no contact is missed, however short the
+step's approach and retreat. The clamp indicator (not polynomial) is sampled at the 15 points
+and bracketed with ``brentq``. A redone step is checked again (a root placed by a step that
+straddled the kink can be late). Each event fires when its function passes a dead band
+beyond zero (see ``_Reference.rows``), against round-off chatter at grazing contacts.
+Peak force and maximum penetration: the maximum of their Chebyshev interpolant on each
+step. Balls may enter later (``release_times``).
 """
 
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.polynomial import chebyshev as cheb
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
@@ -48,13 +49,15 @@ from tailbeam.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES, InclinedPlate
 from tailbeam.physics.pair import pair_kinematics, plate_foot
 from tailbeam.solvers.records import PLATE, ContactRecord, EventKind, LeaveEvent
+from tailbeam.solvers.step_events import (
+    STEP_POINTS,
+    certified_positive,
+    chebyshev_coefficients,
+    first_downward_crossing,
+    interpolant_max,
+)
 
-NODES = 15  # Chebyshev points per step: exact for the degree-14 squared distances
-_U = -np.cos(np.pi * np.arange(NODES) / (NODES - 1))  # increasing, -1 .. 1
-_S = 0.5 * (_U + 1.0)  # the same points as fractions of the step
-_VINV = np.linalg.inv(cheb.chebvander(_U, NODES - 1))
 SAME_TIME = 1e-9  # events closer than this (fraction of a step) are simultaneous
-FRESH_S = 1e-10  # roots closer than this (fraction of a step) to a restart are the restart's
 
 
 @dataclass
@@ -362,22 +365,21 @@ class _Reference:
         rows = self.rows()
         if not rows or t1 <= t0:
             return None
-        x, v = self.states_at(dense, t0 + _S * (t1 - t0))
+        x, v = self.states_at(dense, t0 + STEP_POINTS * (t1 - t0))
         values = self.row_values(rows, x, v)
         # g = sign x value + band: positive on the row's side, its event where g < 0
         g = (
             np.array([r[1] for r in rows])[:, None] * values
             + np.array([r[3] for r in rows])[:, None]
         )
-        coef = g @ _VINV.T  # Chebyshev coefficients of every row
-        bound = np.sum(np.abs(coef[:, 1:]), axis=1) * (1.0 + 1e-12)
-        certified = (coef[:, 0] > bound) & np.array([r[2] for r in rows])
+        coef = chebyshev_coefficients(g)  # Chebyshev coefficients of every row
+        certified = certified_positive(coef) & np.array([r[2] for r in rows])
         best = (math.inf, None)
         for r in np.flatnonzero(~certified):
             key, _, poly, _ = rows[r]
             is_fresh = _same_switch(key, fresh)
             if poly:
-                s = _first_poly_crossing(coef[r], g[r], is_fresh)
+                s = first_downward_crossing(coef[r], g[r], is_fresh)
             else:
                 s = self.first_sampled_crossing(rows[r], g[r], dense, t0, t1, is_fresh)
             if s < best[0]:
@@ -404,7 +406,7 @@ class _Reference:
             x, v = self.states_at(dense, np.array([t0 + s * (t1 - t0)]))
             return sign * self.row_values([row], x, v)[0, 0] + band
 
-        return brentq(f, _S[k - 1], _S[k], xtol=1e-15, rtol=1e-15)
+        return brentq(f, STEP_POINTS[k - 1], STEP_POINTS[k], xtol=1e-15, rtol=1e-15)
 
     def apply(self, key, t, y):
         """Apply event ``key`` at time t with state y; returns the next first step (s)."""
@@ -540,17 +542,17 @@ class _Reference:
         pairs = [p for p in self.pairs.values() if p.in_contact]
         if not pairs or t1 <= t0:
             return
-        force, delta = self.pair_forces(pairs, *self.states_at(dense, t0 + _S * (t1 - t0)))
+        force, delta = self.pair_forces(pairs, *self.states_at(dense, t0 + STEP_POINTS * (t1 - t0)))
         # Refined only where the node maximum comes within 1 % of the record so far: between
         # nodes the interpolant cannot exceed them by more (a step resolved to rtol 1e-12
         # spans ~(1e-12)^(1/8) of the force's time scale; the overshoot is ~1e-6).
         for q, p in enumerate(pairs):
             if force[q].max() >= 0.99 * p.peak:
-                s_peak, peak = _interpolant_max(force[q])
+                s_peak, peak = interpolant_max(force[q])
                 if peak > p.peak:
                     p.peak, p.t_peak = peak, t0 + s_peak * (t1 - t0)
             if delta[q].max() >= 0.99 * p.pen:
-                p.pen = max(p.pen, _interpolant_max(delta[q])[1])
+                p.pen = max(p.pen, interpolant_max(delta[q])[1])
 
     def pair_forces(self, pairs, x, v):
         """Force (N) and penetration (m) of ``pairs`` at states x, v (K, n, 3): (P, K) each."""
@@ -615,47 +617,6 @@ def _same_switch(key, fresh) -> bool:
         ):
             return True
     return False
-
-
-def _first_poly_crossing(c, values, is_fresh) -> float:
-    """First fraction s in [0, 1] of the step where the degree-14 polynomial g with Chebyshev
-    coefficients ``c`` (``values`` at the Chebyshev points) becomes negative; inf if none.
-    (Rows with c0 > sum |c_k| are certified positive and never get here.)"""
-    if not is_fresh and values[0] < 0.0:
-        return 0.0
-    dc = cheb.chebder(c)
-    best = math.inf
-    for r in cheb.chebroots(c):
-        if abs(r.imag) > 1e-6 or not -1.0 - 1e-9 <= r.real <= 1.0 + 1e-9:
-            continue
-        u = float(r.real)
-        for _ in range(3):  # Newton polish on the interpolant
-            d = cheb.chebval(u, dc)
-            if d == 0.0:
-                break
-            u = min(max(u - cheb.chebval(u, c) / d, -1.0), 1.0)
-        s = 0.5 * (u + 1.0)
-        if is_fresh and s < FRESH_S:
-            continue
-        if cheb.chebval(u, dc) < 0.0 and s < best:  # a crossing downwards
-            best = s
-    return best
-
-
-def _interpolant_max(values) -> tuple[float, float]:
-    """(s, value) of the maximum on [0, 1] of the degree-14 Chebyshev interpolant through
-    ``values`` at the Chebyshev points: the largest of the node values and the interpolant at
-    the real roots of its derivative. Inside a region the force and penetration are smooth
-    and each step is resolved to rtol, so the interpolant is accurate to about rtol there."""
-    k = int(np.argmax(values))
-    best_u, best = _U[k], float(values[k])
-    c = _VINV @ values
-    for r in cheb.chebroots(cheb.chebder(c)):
-        if abs(r.imag) < 1e-9 and -1.0 < r.real < 1.0:
-            value = float(cheb.chebval(r.real, c))
-            if value > best:
-                best_u, best = float(r.real), value
-    return 0.5 * (best_u + 1.0), best
 
 
 def _law_table(pairs) -> _Laws:
