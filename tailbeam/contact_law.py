@@ -154,3 +154,51 @@ def impact_force(delta, delta_dot, law: ImpactLaw):
     if law.clamp:
         force = np.maximum(force, 0.0)
     return np.where(inside, force, 0.0)
+
+
+# --- The law region by region (for integrators that stop at every kink) -------------------
+# A kink-respecting integrator (the slow references) integrates each region of the law with
+# that region's smooth formula, extended past the region's borders, and stops at the border.
+# Regions: ``ramp`` (delta < d: damping c STEP(delta, 0, 0, d, c)) or full damping (delta >= d:
+# damping c), and ``clamped`` (Adams' max(0, .) active: force 0). These helpers are the same
+# law as ``impact_force`` (tests/test_contact_law_regions.py checks they agree in each region).
+
+
+def damping_in_region(delta, law: ImpactLaw, ramp):
+    """Damping coefficient in N s/m: the STEP cubic (extended past [0, d]) where ``ramp``,
+    else c. Array-friendly: ``law`` may hold arrays of parameters (one per pair) and
+    ``ramp`` an array of flags."""
+    s = np.asarray(delta, dtype=float) / law.penetration
+    return np.where(ramp, law.damping * s * s * (3.0 - 2.0 * s), law.damping)
+
+
+def impact_force_in_region(delta, delta_dot, law: ImpactLaw, ramp, clamped):
+    """Force in N of one region's smooth formula; delta <= 0 gives the elastic term 0.
+
+    Array-friendly like ``damping_in_region`` (``clamped``: flags, force 0 where set)."""
+    pos = np.maximum(np.asarray(delta, dtype=float), 0.0)
+    raw = law.stiffness * pos**law.exponent + damping_in_region(pos, law, ramp) * delta_dot
+    return np.where(clamped, 0.0, raw)
+
+
+def clamp_indicator(delta: float, delta_dot: float, law: ImpactLaw, ramp: bool) -> float:
+    """raw force / (k delta^e): the sign of the unclamped force, not 0 at delta = 0.
+
+    Its zero is the clamp kink (clamp on/off); unlike the force it does not vanish at
+    separation, so the clamp events never coincide with contact end. At delta <= 0: the limit
+    at delta -> 0+.
+    """
+    k, e, c, d = law.stiffness, law.exponent, law.damping, law.penetration
+    if delta > 0.0:
+        return 1.0 + float(damping_in_region(delta, law, ramp)) * delta_dot / (k * delta**e)
+    if ramp and e < 2.0:
+        return 1.0
+    if ramp and e == 2.0:
+        return 1.0 + 3.0 * c * delta_dot / (k * d * d)
+    return -1.0 if delta_dot < 0.0 else 1.0
+
+
+def elastic_energy(delta, law: ImpactLaw):
+    """Energy in J stored by the elastic term: k delta^(e+1) / (e+1) for delta > 0, else 0."""
+    pos = np.maximum(np.asarray(delta, dtype=float), 0.0)
+    return law.stiffness * pos ** (law.exponent + 1.0) / (law.exponent + 1.0)

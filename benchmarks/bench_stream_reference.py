@@ -1,0 +1,83 @@
+"""Convergence and cost of the slow stream reference against its tolerance.
+
+    python benchmarks/bench_stream_reference.py [--quick]
+
+Scene: the ten-ball scene of the tests (tests/stream_scenes.py: a 3-ball cluster, a ball
+resting on the 15 degree plate hit by another, two mid-air collisions, one free fall),
+c = 2000 N s/m, d = 2e-5 m, 0.1 s. Truth: the same reference at rtol 1e-13. For rtol 1e-7 ..
+1e-12: wall time, steps, and the largest relative error over every contact's peak force,
+v_out (relative to max(|v_out|, approach speed): a ball left at rest has v_out ~ 0) and
+duration, with the contacts matched by (ball, partner, n-th contact of that pair). The
+measured order is the slope of log(error) against log(rtol).
+"""
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from stream_scenes import ten_ball_scene  # noqa: E402
+
+from tailbeam.physics.incline import InclinedPlate  # noqa: E402
+from tailbeam.solvers.stream_reference import simulate_stream_reference  # noqa: E402
+
+INCLINE = InclinedPlate(inclination=15.0)
+
+
+def run(rtol, duration):
+    t = time.perf_counter()
+    res = simulate_stream_reference(ten_ball_scene(INCLINE), INCLINE, duration, rtol=rtol,
+                                    damping=2000.0, penetration=2e-5)  # fmt: skip
+    return res, time.perf_counter() - t
+
+
+def _by_key(res):
+    """Contacts keyed by (ball, partner, n-th contact of that pair)."""
+    seen, out = {}, {}
+    for c in res.contacts:
+        n = seen[(c.ball, c.partner)] = seen.get((c.ball, c.partner), 0) + 1
+        out[(c.ball, c.partner, n)] = c
+    return out
+
+
+def error(res, truth):
+    ours, ref = _by_key(res), _by_key(truth)
+    if set(ours) != set(ref):
+        return float("inf")  # a different set of contacts
+    worst = 0.0
+    for key, b in ref.items():
+        a = ours[key]
+        for x, y, scale in ((a.peak_force, b.peak_force, 0.0),
+                            (a.v_out, b.v_out, b.approach_in),
+                            (a.t_end - a.t_start, b.t_end - b.t_start, 0.0)):  # fmt: skip
+            if np.isfinite(y) and max(abs(y), scale) > 0.0:
+                worst = max(worst, abs(x - y) / max(abs(y), scale))
+    return worst
+
+
+def main(quick=False):
+    duration = 0.06 if quick else 0.1
+    truth, t_truth = run(1e-13, duration)
+    print(f"truth rtol 1e-13: {t_truth:.1f} s, {truth.steps} steps, "
+          f"{len(truth.contacts)} contact records")  # fmt: skip
+    print("| rtol | wall (s) | steps | max rel. error |\n|---|---|---|---|")
+    rtols, errors = [], []
+    for rtol in (1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12):
+        res, wall = run(rtol, duration)
+        err = error(res, truth)
+        rtols.append(rtol)
+        errors.append(err)
+        print(f"| {rtol:g} | {wall:.2f} | {res.steps} | {err:.2e} |", flush=True)
+    ok = [(r, e) for r, e in zip(rtols, errors, strict=True) if np.isfinite(e) and e > 0]
+    if len(ok) >= 2:
+        slope = np.polyfit(np.log([r for r, _ in ok]), np.log([e for _, e in ok]), 1)[0]
+        print(f"\nmeasured order: error ~ rtol^{slope:.2f}")
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="0.06 s instead of 0.1 s")
+    main(parser.parse_args().quick)

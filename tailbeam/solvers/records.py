@@ -1,0 +1,63 @@
+"""What a stream solver reports: event kinds, contact (impact) records and leave events.
+
+Written once here so the fast stream solver and the slow reference report the same shape
+(the refactor of issue 7 extends this to every solver).
+"""
+
+from dataclasses import asdict, dataclass
+from enum import Enum
+
+PLATE = "plate"  # the partner name of a ball-plate contact
+
+
+class EventKind(str, Enum):
+    """Kinks and changes a solver stops at (the value is what the outputs write)."""
+
+    CONTACT_START = "contact_start"
+    CONTACT_END = "contact_end"
+    FULL_DAMPING = "full_damping"  # penetration crosses d (the STEP ramp ends/starts)
+    CLAMP_ON = "clamp_on"
+    CLAMP_OFF = "clamp_off"
+    LEAVE = "leave"  # a ball's centre passed an edge of the plate
+    RELEASE = "release"  # a ball entered the scene (a stream particle's release time)
+
+
+@dataclass
+class ContactRecord:
+    """One contact of one ball (a ball-ball contact gives one record per ball).
+
+    partner: ``plate`` or the other ball's name. Times in s. Speeds in m/s along the contact
+    normal n (from the partner to the ball): v_in = -v . n at first touch (> 0 approaching),
+    v_out = v . n at the end (> 0 leaving); approach_in / approach_out: the same for the
+    relative velocity of the pair (penetration rate at start, minus it at the end).
+    peak_force (N) at t_peak, max_penetration (m); x, y: contact point in the plate frame
+    at first touch (m). end: ``separated``, ``left`` (a ball left the plate during the
+    contact) or ``duration`` (the simulation ended during it; v_out etc. are nan).
+    """
+
+    ball: str
+    partner: str
+    t_start: float
+    x: float
+    y: float
+    v_in: float
+    approach_in: float
+    t_end: float = float("nan")
+    v_out: float = float("nan")
+    approach_out: float = float("nan")
+    peak_force: float = 0.0
+    t_peak: float = float("nan")
+    max_penetration: float = 0.0
+    end: str = "duration"
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class LeaveEvent:
+    """Ball ``ball`` left the plate over ``edge`` (``x+`` downhill, ...) at ``time`` s."""
+
+    ball: str
+    time: float
+    edge: str

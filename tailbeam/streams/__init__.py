@@ -1,0 +1,1 @@
+"""Caving streams as scene input: the particle generator (``tailbeam.streams.generator``)."""

@@ -1,0 +1,40 @@
+"""Scenes shared by the stream tests (not a test module)."""
+
+import math
+
+from tailbeam import COAL, SANDSTONE, Ball, ball_plate_law
+from tailbeam.materials import CARBON_STEEL
+
+
+def static_penetration_on(material, radius, incline) -> float:
+    """Penetration in m at which a ball of ``material``, ``radius`` rests on ``incline``
+    (normal force m g cos theta; the closed form of tailbeam.hertz)."""
+    law = ball_plate_law(material, radius, CARBON_STEEL)
+    ball = Ball("probe", material, radius, (0.0, 0.0, 1.0))
+    normal_load = ball.mass * incline.gravity * math.cos(math.radians(incline.inclination))
+    return law.static_penetration(normal_load)
+
+
+def ten_ball_scene(incline):
+    """Ten balls, several ball-ball contacts, a 3-ball cluster and a stacked pair.
+
+    - b1, b2, b3 in a row along y, level, in flight: b1 and b3 reach b2 at the same time
+      (three balls touching at once);
+    - s1 rests on the plate (static penetration) and s2 falls onto it (ball-ball and
+      ball-plate contact at once); both slide downhill alike (frictionless);
+    - p1/p2 meet head-on in flight, p3 (sandstone)/p4 (coal) obliquely; f1 falls alone.
+    """
+    r_s1 = 0.03
+    z_s1 = r_s1 - static_penetration_on(COAL, r_s1, incline)
+    return [
+        Ball("b1", COAL, 0.02, (-0.1, -0.1, 0.15), (0.0, 1.0, 0.0)),
+        Ball("b2", COAL, 0.02, (-0.1, 0.0, 0.15), (0.0, 0.0, 0.0)),
+        Ball("b3", COAL, 0.02, (-0.1, 0.1, 0.15), (0.0, -1.0, 0.0)),
+        Ball("s1", COAL, r_s1, (0.1, 0.1, z_s1), (0.0, 0.0, 0.0)),
+        Ball("s2", SANDSTONE, 0.02, (0.1, 0.1, 0.12), (0.0, 0.0, -0.5)),
+        Ball("p1", COAL, 0.025, (0.15, -0.15, 0.1), (0.0, 0.5, 0.0)),
+        Ball("p2", COAL, 0.015, (0.15, -0.05, 0.1), (0.0, -0.5, 0.0)),
+        Ball("p3", SANDSTONE, 0.02, (-0.15, 0.2, 0.08), (0.6, 0.0, 0.0)),
+        Ball("p4", COAL, 0.025, (0.0, 0.21, 0.08), (-0.6, 0.0, 0.0)),
+        Ball("f1", SANDSTONE, 0.035, (-0.2, -0.2, 0.1), (0.2, 0.1, -1.0)),
+    ]
