@@ -59,9 +59,11 @@ def write_results(out_dir, scene, result) -> list:
         write_json(out_dir / "impacts.json", summary),
         write_timeseries_csv(out_dir / "timeseries.csv", result, scene.sample_rate),
     ]
-    outputs = getattr(result, "sensor_outputs", None)
-    if outputs:
-        with task("writing sensor outputs", total=len(outputs), unit="sensors") as bar:
+    if getattr(result, "sensors", ()):
+        n = len(result.sensors)
+        with task(f"sensor replay and outputs, {n} sensors", total=n + 1, unit="steps") as bar:
+            outputs = result.sensor_outputs  # the exact plate response through each chain
+            bar.update(1)
             files += _write_sensors(out_dir, scene, result, outputs, bar)
     return files
 
