@@ -50,7 +50,7 @@ class _LogBar:
 
     def _line(self, final=False):
         elapsed = time.monotonic() - self.start
-        done = f"{self.n:g}" + (f"/{self.total:g}" if self.total else "")
+        done = f"{self.n:.4g}" + (f"/{self.total:.4g}" if self.total else "")
         unit = f" {self.unit}" if self.unit else ""
         if not self.total and not self.n:  # nothing counted: elapsed time only
             done = unit = ""

@@ -9,7 +9,7 @@ results replace DIR whole (tailbeam.output), so DIR never mixes two runs.
 
 from tailbeam.cachedir import announce_first_compile
 from tailbeam.output import atomic_output_dir, check_output_dir, describe
-from tailbeam.progress import note, task
+from tailbeam.progress import task
 
 # Heavy modules (scipy.signal, matplotlib) are imported where they are used, so that
 # `tailbeam --help` and bad-input errors answer in a fraction of a second.
@@ -106,10 +106,6 @@ def run(args) -> int:
     scene = load_scene(args.scene)
     announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
     result = solve(scene)
-    if scene.plate_model == "modal":
-        from tailbeam.coupled.auto import describe_choices
-
-        note(describe_choices(result.info))
     with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:
         files = write_results(tmp, scene, result)
     n = len(result.impacts)

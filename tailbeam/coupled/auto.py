@@ -27,12 +27,10 @@ Band. Two outputs need modes: the sensor signals and the contact forces.
 fmax = max(sensor bandwidth, contact band), rounded up to a multiple of BAND_GRID_HZ so that
 small edits of a scene reuse the cached basis. The user's [plate] fmax overrides.
 
-Assumption for the sensors (stated in result.info["band"]["sensor_note"]): with fmax at the
-bandwidth every mode a sensor can see is kept; the modes above fmax reach a sensor only
-through their quasi-static (local) response, which is small a wavelength away from the
-contacts and which the mode-acceleration correction of issue 9 adds at the sensors. Once it
-is in, nothing here changes: the sensor band stays the bandwidth and the contact band is
-already set by the residual flexibility at the contacts.
+The sensors (result.info["band"]["sensor_note"]): with fmax at the bandwidth every mode a
+sensor can see is kept; the modes above fmax reach a sensor only through their quasi-static
+response, which the mode-acceleration correction adds at each sensor when residual
+flexibility is on (CoupledResult.plate_sample, docs/fe-convergence.md).
 
 Cost. Before anything is assembled the basis's DOFs, modes, memory and time are estimated
 (tailbeam.plate.cost) and a band over the limits is refused naming ``plate.fmax``.
@@ -48,6 +46,7 @@ from tailbeam.contact_law import impact_force, impact_force_scalar
 from tailbeam.coupled.solver import simulate_coupled
 from tailbeam.errors import InputError
 from tailbeam.hertz import hertz_contact_duration
+from tailbeam.progress import note
 from tailbeam.scene import ModalPlateSettings, Scene
 from tailbeam.sensor import resolve
 
@@ -193,8 +192,8 @@ def choose_band(scene: Scene, settings: ModalPlateSettings | None = None) -> dic
         "truncation_force_level": _spectrum_level(fmax, t_min),
         "sensor_band_covered": bool(fmax >= f_sensor),
         "sensor_note": (
-            "modes above fmax reach the sensors only quasi-statically (not included until "
-            "the mode-acceleration correction, issue 9)"
+            "modes above fmax reach the sensors quasi-statically (mode-acceleration "
+            "correction, with residual flexibility on)"
         ),
     }
 
@@ -247,6 +246,8 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
     band = choose_band(scene, settings)
     if basis is None:
         basis = build_basis(scene, band, use_cache=use_cache)
+    choices = _choices(band, basis)
+    note(describe_choices(choices))  # before the run, so a long run says what it runs
     result = simulate_coupled(
         scene.balls,
         basis,
@@ -260,8 +261,13 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
         gravity=scene.gravity,
         **options,
     )
-    result.info["band"] = band
-    result.info["basis"] = {
+    result.info.update(choices)
+    return result
+
+
+def _choices(band: dict, basis) -> dict:
+    """The automatic choices as recorded in result.info (band, basis) and impacts.json."""
+    described = {
         "theory": basis.theory,
         "boundary": basis.boundary,
         "n_modes": basis.n_modes,
@@ -270,8 +276,8 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
     }
     cost = basis.info.get("cost_estimate")
     if isinstance(cost, dict):
-        result.info["basis"]["cost_estimate"] = cost
-    return result
+        described["cost_estimate"] = cost
+    return {"band": band, "basis": described}
 
 
 def describe_choices(info: dict) -> str:
