@@ -32,6 +32,17 @@ def is_quiet() -> bool:
     return _state["quiet"]
 
 
+@contextlib.contextmanager
+def quiet():
+    """Silence progress and notes inside the block (e.g. a sweep's cases), then restore."""
+    before = _state["quiet"]
+    _state["quiet"] = True
+    try:
+        yield
+    finally:
+        _state["quiet"] = before
+
+
 def note(message: str) -> None:
     """One line on stderr, prefixed ``tailbeam:``, unless quiet."""
     if not _state["quiet"]:

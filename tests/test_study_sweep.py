@@ -144,3 +144,16 @@ def test_progress_lines_show_failures(monkeypatch, capsys):
     assert lines[0].startswith("tailbeam: sweep of 3 cases: 1/3 cases, ")
     assert "left" in lines[0]  # time left
     assert lines[-1].startswith("tailbeam: sweep of 3 cases: 3/3 cases (1 failed), ")
+
+
+def test_a_case_prints_nothing_and_restores_progress(capsys):
+    """Cases run silently (the sweep's bar is the progress; per-case notes from workers
+    would flood the user's terminal) and leave the process's progress setting as it was."""
+    from tailbeam.progress import is_quiet
+    from tailbeam.study.case import run_case
+
+    assert not is_quiet()
+    out = run_case(BASE, ("coal",))
+    assert out["status"] == "ok", out["error"]
+    assert capsys.readouterr().err == ""
+    assert not is_quiet()

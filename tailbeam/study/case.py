@@ -12,6 +12,7 @@ import traceback
 
 import numpy as np
 
+from tailbeam.progress import quiet
 from tailbeam.results_io import IMPACT_COLUMNS
 
 
@@ -42,7 +43,8 @@ def warm_basis(scene_toml: str) -> str:
     from tailbeam.scene_file import loads_scene
 
     try:
-        basis = build_basis(loads_scene(scene_toml))
+        with quiet():  # a worker's notes and bars would interleave on the user's terminal
+            basis = build_basis(loads_scene(scene_toml))
     except Exception as err:  # noqa: BLE001 - the cases then fail with their own error
         return f"basis not cached: {_one_line(err)}"
     return f"{basis.theory} {basis.boundary}, {basis.n_modes} modes"
@@ -76,7 +78,8 @@ def run_case(scene_toml: str, coal: tuple, *_after) -> dict:
     c0 = time.process_time()
     out = {"status": "failed", "error": "", "signals": {}, "impacts": []}
     try:
-        result = solve(loads_scene(scene_toml))
+        with quiet():  # the sweep's own bar reports progress; per-case notes would flood it
+            result = solve(loads_scene(scene_toml))
         if result.status != 0:
             out["error"] = f"solver stopped: {result.message}".splitlines()[0]
         else:
