@@ -29,11 +29,12 @@ FLUSH_SECONDS = 30.0  # write a batch after this long (s) ...
 FLUSH_BYTES = 64 << 20  # ... or once its signals take this many bytes ...
 FLUSH_CASES = 5000  # ... or once it holds this many cases, whichever comes first
 GATHER_INTERVAL_S = 0.1  # collect finished results at most this often (s)
-# worker processes of a local cluster: Dask's defaults minus two per-task costs that weigh on
-# cases of a few tens of ms: the statistical profiler (samples every thread each 10 ms) and
-# MALLOC_TRIM_THRESHOLD_=65536 (it turns off glibc's adaptive mmap threshold: every large
-# numpy temporary is then mmapped and unmapped, ~10 % slower cases measured). Memory stays
-# bounded by each worker's memory_limit (the nanny restarts a worker past 95 % of it).
+# worker processes of a local cluster: Dask's defaults minus two costs that weigh on cases of a
+# few tens of ms: MALLOC_TRIM_THRESHOLD_=65536 (setting it turns off glibc's dynamic mmap
+# threshold, so large numpy temporaries are mmapped and unmapped each time: cases ~10 % slower,
+# measured) and the statistical profiler (it samples the task thread every 10 ms; not
+# measured on its own). Memory stays bounded by each worker's memory_limit (the worker pauses
+# at 80 % of it, the nanny restarts it past 95 %).
 WORKER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.nanny.pre-spawn-environ": {
