@@ -24,6 +24,9 @@ def basis_signature(scene) -> str:
     m = scene.modal
     p = scene.plate
     mat = p.material
+    # the band choose_band would give: the scene's plate.fmax when set (then the contact
+    # pulses it also estimates, ~5 ms per case, are not needed here)
+    fmax = m.fmax_hz if m.fmax_hz is not None else choose_band(scene, m)["fmax_hz"]
     return json.dumps(
         [
             [p.size_x, p.size_y, p.thickness],
@@ -31,7 +34,7 @@ def basis_signature(scene) -> str:
             m.boundary,
             m.theory,
             m.mesh_divisions,
-            float(choose_band(scene, m)["fmax_hz"]),
+            float(fmax),
         ]
     )
 

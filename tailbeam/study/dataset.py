@@ -177,12 +177,12 @@ class DatasetStore:
     def _write_impacts(self, ok: list) -> None:
         import pandas as pd
 
-        frames = [self.impacts] if self.impacts is not None else []
-        for row, case, result, _scene in ok:
-            df = pd.DataFrame(result["impacts"])
-            if len(df):
-                frames.append(df.assign(case=row["case"], case_hash=case.hash))
-        frames = [f for f in frames if len(f)]
+        rows = [
+            {"case": row["case"], "case_hash": case.hash, **impact}
+            for row, case, result, _scene in ok
+            for impact in result["impacts"]
+        ]
+        frames = [f for f in (self.impacts, pd.DataFrame(rows)) if f is not None and len(f)]
         if not frames:
             return
         table = pd.concat(frames, ignore_index=True)
