@@ -20,10 +20,13 @@ from tailbeam.errors import (
     require_real,
     require_vector,
 )
-from tailbeam.materials import BUILTIN_MATERIALS, Material, get_material
+from tailbeam.materials import Material, get_material
 from tailbeam.noise import NoiseSpec
 from tailbeam.preflight import check_scene
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene, SensorSpec
+
+# writing back lives in tailbeam.scene_dump; re-exported so existing imports keep working
+from tailbeam.scene_dump import MATERIAL_KEYS, dumps_scene, scene_to_dict  # noqa: F401
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -53,7 +56,6 @@ MODAL_KEYS = (
     "residual_flexibility",
     "coupling",
 )
-MATERIAL_KEYS = ("density", "youngs_modulus", "poisson_ratio")
 BALL_KEYS = ("name", "material", "radius", "position", "velocity")
 SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance", "noise")
 NOISE_KEYS = ("rms", "background", "band", "seed")
@@ -339,101 +341,3 @@ def _parse_noise(field: str, value) -> NoiseSpec:
     except InputError as err:  # NoiseSpec names its fields noise.<key>
         inner = err.field[len("noise") :] if table is value else ""
         raise InputError(field + inner, err.rule) from None
-
-
-# -- writing back ---------------------------------------------------------------------------------
-
-
-def scene_to_dict(scene: Scene) -> dict:
-    """The scene as a table with the scene-file keys (for echoing into results, or dumping)."""
-    c = scene.contact
-    p = scene.plate
-    plate = {
-        "model": scene.plate_model,
-        "material": p.material.name,
-        "size": [p.size_x, p.size_y, p.thickness],
-    }
-    if scene.plate_model == "modal" and scene.modal is not None:
-        m = scene.modal
-        plate.update(
-            boundary=m.boundary,
-            theory=m.theory,
-            damping_ratio=m.damping_ratio,
-            residual_flexibility=m.residual_flexibility,
-            coupling=m.coupling,
-        )
-        if m.rayleigh is not None:
-            plate["rayleigh"] = list(m.rayleigh)
-        if m.fmax_hz is not None:
-            plate["fmax"] = m.fmax_hz
-        if m.mesh_divisions is not None:
-            plate["mesh_divisions"] = m.mesh_divisions
-    used = {b.material for b in scene.balls} | {p.material}
-    materials = {
-        m.name: {k: getattr(m, k) for k in MATERIAL_KEYS}
-        for m in sorted(used, key=lambda m: m.name)
-        if BUILTIN_MATERIALS.get(m.name) != m
-    }
-    out = {"duration": scene.duration, "sample_rate": scene.sample_rate, "gravity": scene.gravity}
-    out["contact"] = {
-        "exponent": c.exponent,
-        "damping": c.damping,
-        "penetration": c.penetration,
-        "clamp": c.clamp,
-    }
-    out["plate"] = plate
-    if materials:
-        out["materials"] = materials
-    out["balls"] = [
-        {
-            "name": b.name,
-            "material": b.material.name,
-            "radius": b.radius,
-            "position": list(b.position),
-            "velocity": list(b.velocity),
-        }
-        for b in scene.balls
-    ]
-    sensors = []
-    for s in scene.sensors:
-        d = {"name": s.name, "position": list(s.position), "sample_rate": s.sample_rate}
-        if s.bandwidth_hz is not None:
-            d["bandwidth"] = s.bandwidth_hz
-        if s.mounted_resonance_hz is not None:
-            d["mounted_resonance"] = s.mounted_resonance_hz
-        if s.noise is not None:
-            n = s.noise
-            d["noise"] = {"rms": n.rms, "background": n.background, "band": list(n.band_hz)}
-            d["noise"]["seed"] = n.seed
-        sensors.append(d)
-    if sensors:
-        out["sensors"] = sensors
-    return out
-
-
-def _toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else ("nan" if v != v else ("inf" if v > 0 else "-inf"))
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
-    return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-
-
-def dumps_scene(scene: Scene) -> str:
-    """The scene as scene-file TOML text (``loads_scene(dumps_scene(s)) == s``)."""
-    d = scene_to_dict(scene)
-    lines = [f"{k} = {_toml_value(d[k])}" for k in ("duration", "sample_rate", "gravity")]
-    for section in ("contact", "plate"):
-        lines += ["", f"[{section}]"] + [f"{k} = {_toml_value(v)}" for k, v in d[section].items()]
-    for name, props in d.get("materials", {}).items():
-        lines += ["", f"[materials.{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in props.items()]
-    for array in ("balls", "sensors"):
-        for entry in d.get(array, []):
-            lines += ["", f"[[{array}]]"] + [f"{k} = {_toml_value(v)}" for k, v in entry.items()]
-    return "\n".join(lines) + "\n"

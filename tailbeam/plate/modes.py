@@ -238,6 +238,29 @@ def _make_basis(
     return basis
 
 
+def _from_cache(path, key, plate, boundary, res, accuracy, degree):
+    """The cached basis at ``path`` (None on a miss or a damaged entry)."""
+    hit = modal_cache.load(path, key)
+    if hit is None:
+        return None
+    freqs, vectors, free_dofs, n_full, cached_mesh, info = hit
+    # same physics and mesh; the request that led here may differ (e.g. accuracy)
+    info.update(cache="hit", cache_file=str(path), reason=res.reason, accuracy=accuracy)
+    return _make_basis(
+        plate,
+        boundary,
+        res.theory,
+        freqs,
+        vectors,
+        free_dofs,
+        n_full,
+        cached_mesh,
+        info,
+        degree=degree,
+        shared_key=key,
+    )
+
+
 def compute_modes(
     plate: Plate,
     boundary: str = "SSSS",
@@ -283,24 +306,9 @@ def compute_modes(
     key = modal_cache.cache_key(plate, boundary, res.theory, element, mesh_obj, fmax_hz, count)
     path = modal_cache.cache_path(cache_dir or modal_cache.default_cache_dir(), key)
     if use_cache:
-        hit = modal_cache.load(path, key)
+        hit = _from_cache(path, key, plate, boundary, res, accuracy, mindlin_degree)
         if hit is not None:
-            freqs, vectors, free_dofs, n_full, cached_mesh, info = hit
-            # same physics and mesh; the request that led here may differ (e.g. accuracy)
-            info.update(cache="hit", cache_file=str(path), reason=res.reason, accuracy=accuracy)
-            return _make_basis(
-                plate,
-                boundary,
-                res.theory,
-                freqs,
-                vectors,
-                free_dofs,
-                n_full,
-                cached_mesh,
-                info,
-                degree=mindlin_degree,
-                shared_key=key,
-            )
+            return hit
     cost = _solve_cost(plate, boundary, res, mesh_obj, fmax_hz, count, mindlin_degree)
     threads = _blas_threads(blas_threads)
     with threadpool_limits(limits=threads):
