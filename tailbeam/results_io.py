@@ -11,32 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-# Column order of impacts.csv: the contract's first ten columns, then the rest.
-IMPACT_COLUMNS = (
-    "ball",
-    "index",
-    "t_start",
-    "t_end",
-    "v_in",
-    "v_out",
-    "restitution",
-    "peak_force",
-    "t_peak",
-    "max_penetration",
-    "next_apex_height",
-    "ends_at_rest",
-)
-IMPACT_UNITS = {
-    "t_start": "s",
-    "t_end": "s",
-    "v_in": "m/s",
-    "v_out": "m/s",
-    "restitution": "1",
-    "peak_force": "N",
-    "t_peak": "s",
-    "max_penetration": "m",
-    "next_apex_height": "m",
-}
+# Column order of impacts.csv (the contract's first ten columns, then the rest) and units.
+from tailbeam.solvers.stream_result import IMPACT_COLUMNS, IMPACT_UNITS  # noqa: F401
 
 
 def _cell(value) -> str:

@@ -1,0 +1,87 @@
+"""Which solver runs a stream scene: the one switch the fast stream solver replaces.
+
+``stream_engine()`` returns the fast solver ``tailbeam.solvers.stream.simulate_stream`` if
+that module exists, else the slow reference (``simulate_stream_reference``, every pair
+watched, fine for 3-10 balls, refused beyond ``REFERENCE_MAX_PARTICLES``). Both are called
+as ``run(particles, incline, duration, *, laws, rtol, max_steps, progress)`` and return a
+``StreamResult``; ``laws`` carries the IMPACT settings shared by every pair (exponent,
+damping, penetration, clamp: ``tailbeam.scene.ContactSettings``).
+"""
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from tailbeam.solvers.stream_result import StreamResult
+
+FAST_MODULE = "tailbeam.solvers.stream"
+REFERENCE_MAX_PARTICLES = 20  # the reference watches every pair: O(N^2) per step
+REFERENCE_MAX_STEPS = 100_000  # default step budget (memory: every step's state is kept)
+REFERENCE_RTOL = 1e-10
+
+
+@dataclass(frozen=True)
+class StreamEngine:
+    """A stream solver: its name, the function, the most particles it accepts (None: no
+    limit of its own), its default rtol and step budget."""
+
+    name: str
+    run: Callable
+    max_particles: int | None
+    rtol: float
+    max_steps: int
+
+
+def stream_engine() -> StreamEngine:
+    """The fast stream solver if it exists, else the reference (module docstring)."""
+    try:
+        fast = importlib.import_module(FAST_MODULE)
+    except ModuleNotFoundError as err:
+        if err.name != FAST_MODULE:
+            raise
+        return StreamEngine(
+            "reference (scipy DOP853, all pairs watched)",
+            run_reference,
+            REFERENCE_MAX_PARTICLES,
+            REFERENCE_RTOL,
+            REFERENCE_MAX_STEPS,
+        )
+    return StreamEngine(
+        "fast stream solver",
+        fast.simulate_stream,
+        getattr(fast, "MAX_PARTICLES", None),
+        getattr(fast, "DEFAULT_RTOL", REFERENCE_RTOL),
+        getattr(fast, "DEFAULT_MAX_STEPS", REFERENCE_MAX_STEPS),
+    )
+
+
+def reference_memory_bytes(n_particles: int, max_steps: int) -> float:
+    """Upper bound (bytes) of what the reference keeps: per accepted step the time, the
+    energy and every present ball's position and velocity (2 arrays of n x 3 floats plus
+    ~300 bytes of Python objects)."""
+    return max_steps * (48.0 * n_particles + 300.0)
+
+
+def run_reference(particles, incline, duration, *, laws, rtol, max_steps, progress=None):
+    """Run ``particles`` through ``simulate_stream_reference``; returns a StreamResult."""
+    from tailbeam.solvers.stream_reference import simulate_stream_reference
+
+    ref = simulate_stream_reference(
+        [p.ball() for p in particles],
+        incline,
+        duration,
+        damping=laws.damping,
+        penetration=laws.penetration,
+        clamp=laws.clamp,
+        exponent=laws.exponent,
+        rtol=rtol,
+        max_steps=max_steps,
+        release_times=[p.t_release for p in particles],
+        progress=progress,
+    )
+    events = [(t, ball, kind, partner) for t, kind, ball, partner in ref.events]
+    stats = {"n_steps": ref.steps, "n_contacts": len(ref.contacts), "n_leaves": len(ref.leaves)}
+    return StreamResult(
+        list(particles), ref.contacts, ref.leaves, events, incline, duration,
+        status=0, message="reached the end of the simulation", stats=stats, info=dict(ref.info),
+    )  # fmt: skip
