@@ -109,8 +109,8 @@ def check_streams(scene) -> None:
     """Rules for a scene the stream solver runs (streams, an inclined plate or balls that may
     touch): the particle count the solver accepts, from the expected count before the
     particles are generated and the actual count after; then the contact rules for every
-    stream particle (its fall is named ``streams[i].height``). WorkLimitError names the
-    setting to change."""
+    stream particle (``streams[i].height`` or ``.velocity``, whichever gives more speed).
+    WorkLimitError names the setting to change."""
     if not scene.needs_stream_solver:
         return
     from tailbeam.solvers.engine import stream_engine
@@ -121,8 +121,10 @@ def check_streams(scene) -> None:
     streams = {s.name: i for i, s in enumerate(scene.streams, start=1)}
     g_n = scene.gravity * math.cos(math.radians(scene.inclination))
     for p in scene.particles[len(scene.balls) :]:
-        law = scene.contact.law_for(p.ball(), scene.plate.material)
-        check_ball_contact(p.ball(), law, g_n, f"streams[{streams[p.stream]}].height")
+        ball = p.ball()
+        law = scene.contact.law_for(ball, scene.plate.material)
+        key = "velocity" if ball.velocity[2] ** 2 > 2.0 * g_n * ball.gap else "height"
+        check_ball_contact(ball, law, g_n, f"streams[{streams[p.stream]}].{key}")
 
 
 def _check_particle_count(scene, engine, from_streams: float, verb: str) -> None:

@@ -42,6 +42,31 @@ def write_impacts_csv(path, impacts) -> Path:
     return describe(path, units=IMPACT_UNITS)
 
 
+def write_table_csv(path, table: dict, units: dict) -> Path:
+    """A table of columns (name -> numpy array, in order) as CSV; units to the manifest."""
+    from tailbeam.output import describe
+
+    header = list(table)
+    write_csv(path, header, zip(*(table[c] for c in header), strict=True))
+    return describe(path, units={c: u for c, u in units.items() if c in table})
+
+
+def stream_summary(result, scene_echo: dict | None = None) -> dict:
+    """impacts.json of a stream scene: scene echo, units, impacts (rows of impacts.csv),
+    leave events, solver statistics and choices."""
+    from tailbeam.solvers.stream_result import STREAM_IMPACT_UNITS
+
+    table = result.impacts_table()
+    out = {} if scene_echo is None else {"scene": scene_echo}
+    out["units"] = STREAM_IMPACT_UNITS
+    rows = zip(*table.values(), strict=True)
+    out["impacts"] = [dict(zip(table, row, strict=True)) for row in rows]
+    out["leaves"] = [{"ball": e.ball, "time": e.time, "edge": e.edge} for e in result.leaves]
+    out["solver"] = {**result.stats, "status": result.status, "message": result.message}
+    out["automatic_choices"] = dict(result.info)
+    return out
+
+
 def _jsonable(value):
     if isinstance(value, dict):
         return {str(k): _jsonable(v) for k, v in value.items()}

@@ -241,14 +241,14 @@ class Scene:
                     f"its particles are named {s.name}-1, {s.name}-2, ...; a ball is already "
                     f"called {clash[0]!r}",
                 )
-        if self.streams and self.plate_model == "modal":
-            raise InputError(
-                "streams", "streams on the modal plate: not yet (use plate.model = 'rigid')"
-            )
         if self.inclination != 0.0 and self.plate_model == "modal":
             raise InputError(
                 "plate.inclination",
                 "an inclined modal plate: not yet (use plate.model = 'rigid' or inclination 0)",
+            )
+        if self.streams and self.plate_model == "modal":
+            raise InputError(
+                "streams", "streams on the modal plate: not yet (use plate.model = 'rigid')"
             )
 
     @property
