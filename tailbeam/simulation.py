@@ -80,7 +80,11 @@ def _modal(scene, how):
 
 def _stream(scene, how):
     from tailbeam.preflight import check_streams
-    from tailbeam.solvers.engine import reference_memory_bytes, stream_engine
+    from tailbeam.solvers.engine import (
+        reference_memory_bytes,
+        reference_seconds_per_step,
+        stream_engine,
+    )
 
     check_streams(scene)  # (already done by load_scene; a Scene built in Python needs it)
     engine = stream_engine()
@@ -92,10 +96,12 @@ def _stream(scene, how):
             f"max_steps: {max_steps} steps of {len(particles)} particles could keep "
             f"{memory / 1e9:.3g} GB (limit {MAX_STREAM_MEMORY / 1e9:g} GB); lower max_steps"
         )
-    why = _why_stream(scene)
+    worst = max_steps * reference_seconds_per_step(len(particles))
     note(
-        f"{why}: stream solver = {engine.name}, {len(particles)} particles, rtol {rtol:g}, "
-        f"at most {max_steps} steps (<= {memory / 1e6:.0f} MB)"
+        f"{_why_stream(scene)}: stream solver = {engine.name}, {len(particles)} particles, "
+        f"rtol {rtol:g}, at most {max_steps} steps (<= {memory / 1e6:.0f} MB, <= ~{worst / 60:.0f}"
+        " min at the measured cost per step; examples/small_stream.toml takes ~1400 steps per"
+        " simulated second)"
     )
     with task(f"simulating {scene.duration:g} s", total=scene.duration, unit="s") as bar:
         reached = [0.0]

@@ -18,6 +18,10 @@ FAST_MODULE = "tailbeam.solvers.stream"
 REFERENCE_MAX_PARTICLES = 20  # the reference watches every pair: O(N^2) per step
 REFERENCE_MAX_STEPS = 100_000  # default step budget (memory: every step's state is kept)
 REFERENCE_RTOL = 1e-10
+# Wall time of one reference step, s, measured at 10-13 particles on the shared 2-core
+# machine (examples/small_stream.toml: 1082 steps, 2.9 ms each); it grows ~N^2 (all pairs).
+REFERENCE_STEP_SECONDS = 3e-3
+REFERENCE_STEP_PARTICLES = 12
 
 
 @dataclass(frozen=True)
@@ -60,6 +64,11 @@ def reference_memory_bytes(n_particles: int, max_steps: int) -> float:
     energy and every present ball's position and velocity (2 arrays of n x 3 floats plus
     ~300 bytes of Python objects)."""
     return max_steps * (48.0 * n_particles + 300.0)
+
+
+def reference_seconds_per_step(n_particles: int) -> float:
+    """Rough wall time (s) of one reference step with ``n_particles`` (measured, ~N^2)."""
+    return REFERENCE_STEP_SECONDS * max(1.0, (n_particles / REFERENCE_STEP_PARTICLES) ** 2)
 
 
 def run_reference(particles, incline, duration, *, laws, rtol, max_steps, progress=None):
