@@ -299,7 +299,7 @@ class Scene:
                     return j, i, t
         return None
 
-    @property
+    @functools.cached_property
     def needs_stream_solver(self) -> bool:
         """Streams, an inclined plate or balls that may touch each other: the stream solver
         (tailbeam.simulation); otherwise the single-ball solvers are exact and used."""

@@ -20,6 +20,8 @@ import tailbeam
 from tailbeam.bodies import Plate
 from tailbeam.cli import main
 from tailbeam.errors import InputError, WorkLimitError
+from tailbeam.hertz import hertz_max_penetration, hertz_peak_force
+from tailbeam.materials import COAL, SANDSTONE
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.rigid import simulate_rigid
 from tailbeam.scene import Scene
@@ -367,3 +369,50 @@ def test_new_keys_round_trip_through_scene_dump():
     # and a scene without the new keys writes none of them (echoes stay as they were)
     plain = dumps_scene(load_scene(ROOT / "examples" / "two_balls_rigid.toml"))
     assert "inclination" not in plain and "label" not in plain and "streams" not in plain
+
+
+def test_ball_ball_rows_against_conservation_and_hertz():
+    """Two balls head-on in flight, g = 0, c = 0: each ball's row holds its own velocity along
+    its normal, from the elastic-collision closed form (momentum and energy conserved:
+    restitution 1); touch at t = gap / closing speed at x = the touching point; peak force
+    and approach from Hertz with m* and R*."""
+    text = """
+duration = 0.2
+gravity = 0.0
+[contact]
+damping = 0.0
+[[balls]]
+name = "c"
+material = "coal"
+radius = 0.02
+position = [-0.1, 0.0, 0.1]
+velocity = [1.0, 0.0, 0.0]
+[[balls]]
+name = "g"
+material = "sandstone"
+radius = 0.03
+position = [0.1, 0.0, 0.1]
+velocity = [-1.0, 0.0, 0.0]
+"""
+    scene = loads_scene(text)
+    assert scene.needs_stream_solver and scene.labels == ("coal", "gangue")
+    t = tailbeam.simulate(scene, progress=False).impacts_table()
+    assert list(t["ball"]) == ["c", "g"] and list(t["partner"]) == ["g", "c"]
+    m1, m2 = (b.mass for b in scene.balls)
+    u1, u2 = 1.0, -1.0
+    v1 = ((m1 - m2) * u1 + 2 * m2 * u2) / (m1 + m2)
+    v2 = ((m2 - m1) * u2 + 2 * m1 * u1) / (m1 + m2)
+    # normals from the partner to the ball: -x for c, +x for g
+    np.testing.assert_allclose(t["v_in"], [u1, -u2], rtol=1e-12)
+    np.testing.assert_allclose(t["v_out"], [-v1, v2], rtol=1e-9)
+    np.testing.assert_allclose(t["restitution"], 1.0, rtol=1e-9)
+    np.testing.assert_allclose(t["t_start"], 0.15 / 2.0, rtol=1e-12)
+    np.testing.assert_allclose(t["x"], -0.1 + 0.075 + 0.02, atol=1e-12)
+    law = tailbeam.ball_ball_law(COAL, 0.02, SANDSTONE, 0.03, damping=0.0)
+    m_star = m1 * m2 / (m1 + m2)
+    np.testing.assert_allclose(t["peak_force"], hertz_peak_force(m_star, 2.0, law.stiffness), 1e-8)
+    np.testing.assert_allclose(
+        t["max_penetration"], hertz_max_penetration(m_star, 2.0, law.stiffness), 1e-8
+    )
+    assert list(t["material"]) == ["coal", "sandstone"] and list(t["radius"]) == [0.02, 0.03]
+    assert np.isnan(t["next_apex_height"]).all() and not t["ends_at_rest"].any()
