@@ -80,23 +80,18 @@ def _modal(scene, how):
 
 def _stream(scene, how):
     from tailbeam.preflight import check_streams
-    from tailbeam.solvers.engine import (
-        reference_memory_bytes,
-        reference_seconds_per_step,
-        stream_engine,
-    )
+    from tailbeam.solvers.engine import stream_engine
 
     check_streams(scene)  # (already done by load_scene; a Scene built in Python needs it)
     engine = stream_engine()
     particles = scene.particles
     rtol, max_steps = how.get("rtol", engine.rtol), how.get("max_steps", engine.max_steps)
-    memory = reference_memory_bytes(len(particles), max_steps)
+    memory, worst = engine.estimate(len(particles), max_steps)
     if memory > MAX_STREAM_MEMORY:
         raise WorkLimitError(
             f"max_steps: {max_steps} steps of {len(particles)} particles could keep "
             f"{memory / 1e9:.3g} GB (limit {MAX_STREAM_MEMORY / 1e9:g} GB); lower max_steps"
         )
-    worst = max_steps * reference_seconds_per_step(len(particles))
     note(
         f"{_why_stream(scene)}: stream solver = {engine.name}, {len(particles)} particles, "
         f"rtol {rtol:g}, at most {max_steps} steps (<= {memory / 1e6:.0f} MB, <= ~{worst / 60:.0f}"

@@ -416,3 +416,34 @@ velocity = [-1.0, 0.0, 0.0]
     )
     assert list(t["material"]) == ["coal", "sandstone"] and list(t["radius"]) == [0.02, 0.03]
     assert np.isnan(t["next_apex_height"]).all() and not t["ends_at_rest"].any()
+
+
+def test_simulate_bounds_the_stream_work():
+    scene = load_scene(SMALL)
+    with pytest.raises(WorkLimitError, match=r"^max_steps: .* GB"):
+        tailbeam.simulate(scene, max_steps=10**9, progress=False)
+    with pytest.raises(WorkLimitError, match="max_steps=5 steps"):
+        tailbeam.simulate(scene, max_steps=5, progress=False)
+    modal = load_scene(ROOT / "examples" / "modal_plate.toml")
+    with pytest.raises(InputError, match="rtol: is not a setting of the modal"):
+        tailbeam.simulate(modal, rtol=1e-8, progress=False)
+
+
+def test_the_fast_solver_plugs_in_by_existing(monkeypatch):
+    """A module tailbeam.solvers.stream with simulate_stream replaces the reference with no
+    other change (the lead's one-line swap), called with the scene's particles and laws."""
+    import types
+
+    from tailbeam.solvers.engine import stream_engine
+
+    calls = []
+    fake = types.ModuleType("tailbeam.solvers.stream")
+    fake.simulate_stream = lambda *args, **kw: calls.append((args, kw)) or "fast result"
+    fake.MAX_PARTICLES = 10**6
+    monkeypatch.setitem(sys.modules, "tailbeam.solvers.stream", fake)
+    assert stream_engine().name == "fast stream solver"
+    scene = load_scene(SMALL)
+    assert tailbeam.simulate(scene, progress=False) == "fast result"
+    ((args, kw),) = calls
+    assert args[0] == scene.particles and args[2] == scene.duration
+    assert kw["laws"] == scene.contact and args[1] == scene.incline

@@ -6,6 +6,10 @@ watched, fine for 3-10 balls, refused beyond ``REFERENCE_MAX_PARTICLES``). Both 
 as ``run(particles, incline, duration, *, laws, rtol, max_steps, progress)`` and return a
 ``StreamResult``; ``laws`` carries the IMPACT settings shared by every pair (exponent,
 damping, penetration, clamp: ``tailbeam.scene.ContactSettings``).
+
+The fast solver plugs in by existing: a module ``tailbeam/solvers/stream.py`` with
+``simulate_stream`` (same call, same result) and optionally ``MAX_PARTICLES``,
+``DEFAULT_RTOL``, ``DEFAULT_MAX_STEPS`` and ``estimate``; nothing else changes.
 """
 
 import importlib
@@ -27,13 +31,15 @@ REFERENCE_STEP_PARTICLES = 12
 @dataclass(frozen=True)
 class StreamEngine:
     """A stream solver: its name, the function, the most particles it accepts (None: no
-    limit of its own), its default rtol and step budget."""
+    limit of its own), its default rtol and step budget, and ``estimate(n_particles,
+    max_steps) -> (bytes, seconds)``: upper bounds of its memory and wall time."""
 
     name: str
     run: Callable
     max_particles: int | None
     rtol: float
     max_steps: int
+    estimate: Callable
 
 
 def stream_engine() -> StreamEngine:
@@ -49,6 +55,7 @@ def stream_engine() -> StreamEngine:
             REFERENCE_MAX_PARTICLES,
             REFERENCE_RTOL,
             REFERENCE_MAX_STEPS,
+            reference_estimate,
         )
     return StreamEngine(
         "fast stream solver",
@@ -56,19 +63,19 @@ def stream_engine() -> StreamEngine:
         getattr(fast, "MAX_PARTICLES", None),
         getattr(fast, "DEFAULT_RTOL", REFERENCE_RTOL),
         getattr(fast, "DEFAULT_MAX_STEPS", REFERENCE_MAX_STEPS),
+        getattr(fast, "estimate", reference_estimate),
     )
 
 
-def reference_memory_bytes(n_particles: int, max_steps: int) -> float:
-    """Upper bound (bytes) of what the reference keeps: per accepted step the time, the
-    energy and every present ball's position and velocity (2 arrays of n x 3 floats plus
-    ~300 bytes of Python objects)."""
-    return max_steps * (48.0 * n_particles + 300.0)
+def reference_estimate(n_particles: int, max_steps: int) -> tuple[float, float]:
+    """Upper bounds (bytes, s) of the reference's memory and wall time for ``max_steps``.
 
-
-def reference_seconds_per_step(n_particles: int) -> float:
-    """Rough wall time (s) of one reference step with ``n_particles`` (measured, ~N^2)."""
-    return REFERENCE_STEP_SECONDS * max(1.0, (n_particles / REFERENCE_STEP_PARTICLES) ** 2)
+    Memory: per accepted step it keeps the time, the energy and every present ball's
+    position and velocity (2 arrays of n x 3 floats plus ~300 bytes of Python objects).
+    Time: REFERENCE_STEP_SECONDS per step at REFERENCE_STEP_PARTICLES, growing as N^2."""
+    memory = max_steps * (48.0 * n_particles + 300.0)
+    per_step = REFERENCE_STEP_SECONDS * max(1.0, (n_particles / REFERENCE_STEP_PARTICLES) ** 2)
+    return memory, max_steps * per_step
 
 
 def run_reference(particles, incline, duration, *, laws, rtol, max_steps, progress=None):
