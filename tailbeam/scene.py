@@ -301,11 +301,12 @@ class Scene:
 
     @functools.cached_property
     def needs_stream_solver(self) -> bool:
-        """Streams, an inclined plate or balls that may touch each other: the stream solver
-        (tailbeam.simulation); otherwise the single-ball solvers are exact and used."""
-        return (
-            bool(self.streams) or self.inclination != 0.0 or (self.first_ball_contact() is not None)
-        )
+        """A rigid plate with streams, an inclination or balls that may touch each other:
+        the stream solver (tailbeam.simulation); otherwise the single-ball solvers are exact
+        and used (the modal plate refuses such scenes for now)."""
+        if self.plate_model != "rigid":
+            return False
+        return bool(self.streams) or self.inclination != 0.0 or bool(self.first_ball_contact())
 
 
 def _first_approach(dx, dy, ux, uy, reach, duration):
