@@ -29,6 +29,7 @@ from tailbeam.scene import (
     ModalPlateSettings,
     Scene,
     SensorSpec,
+    check_no_ball_contact,
     default_label,
 )
 
@@ -108,8 +109,8 @@ def parse_scene(data: dict) -> Scene:
     incline = InclinedPlate(plate, **kwargs)  # validates plate.inclination
     duration = require_positive("duration", data["duration"])
     balls, labels = _parse_balls(data.get("balls", []), materials, plate, "streams" in data)
-    if model == "modal" and len(balls) > 1:
-        _check_ball_paths(balls, duration)
+    if model == "modal":
+        check_no_ball_contact(balls, duration)
     streams = _parse_streams(data.get("streams", []), incline, materials)
     sensors = _parse_sensors(data.get("sensors", []), plate)
     if sensors and model != "modal":
@@ -282,27 +283,12 @@ def _parse_balls(value, materials: dict, plate: Plate, has_streams: bool) -> tup
 
 def _parse_streams(value, incline: InclinedPlate, materials: dict) -> tuple:
     """Validated ``[[streams]]`` settings (tailbeam.streams.generator.parse_stream)."""
+    tables = _array_of_tables("streams", value)
+    if not tables:
+        return ()
     from tailbeam.streams.generator import parse_stream  # scipy.special: only for streams
 
-    tables = _array_of_tables("streams", value)
     return tuple(parse_stream(t, i, incline, materials) for i, t in enumerate(tables, start=1))
-
-
-def _check_ball_paths(balls, duration: float) -> None:
-    """On the modal plate ball-ball contact is not modelled yet: the horizontal paths (uniform
-    lateral motion) of any two balls must stay at least r1 + r2 apart during the simulation,
-    else they could touch. (The rigid plate sends such scenes to the stream solver.)"""
-    found = Scene(balls, duration=duration).first_ball_contact()
-    if found is not None:
-        j, i, t = found
-        a, b = balls[i], balls[j]
-        raise InputError(
-            f"balls[{j + 1}].position",
-            f"ball {b.name!r} comes closer (horizontally) than the sum of the radii, "
-            f"{a.radius + b.radius:.4g} m, to ball {a.name!r} at t = {t:.4g} s, so they could "
-            "touch; ball-ball contact on the modal plate is not modelled yet (plate.model = "
-            "'rigid' runs it)",
-        )
 
 
 def _parse_sensors(value, plate: Plate) -> tuple:

@@ -62,17 +62,11 @@ def _rigid(scene, how):
 
 def _modal(scene, how):
     from tailbeam.coupled import simulate_scene_modal
+    from tailbeam.scene import check_no_ball_contact
 
     if how:
         raise InputError(next(iter(how)), "is not a setting of the modal plate solver")
-    found = scene.first_ball_contact() if len(scene.balls) > 1 else None
-    if found is not None:
-        j, i, t = found
-        raise InputError(
-            f"balls[{j + 1}].position",
-            f"may touch ball {scene.balls[i].name!r} at t = {t:.4g} s; ball-ball contact on the "
-            "modal plate is not modelled yet (plate.model = 'rigid' runs it)",
-        )
+    check_no_ball_contact(scene.balls, scene.duration)
     # The modal path chooses its band from the scene (contact durations, sensor bandwidths),
     # the theory from the band, and records both choices in result.info.
     return simulate_scene_modal(scene)
