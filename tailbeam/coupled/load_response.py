@@ -1,0 +1,270 @@
+"""The modal plate's exact answer to sparse load histories (``PlateLoads``), at a few points.
+
+One-way: the loads are prescribed (a stream's contact forces and dead loads); the plate's
+motion does not act back on them. Every kept mode is driven exactly by the piecewise-linear
+forces (the closed-form propagation of ``tailbeam.coupled.propagator``, organised as in
+``tailbeam.coupled.load_kernel``: a particular part that follows the force and a free
+homogeneous part that jumps at load nodes), so the result is exact at the samples whatever
+the node times. Optionally the truncated modes' quasi-static response is added at the points
+(as ``CoupledResult.quasi_static_sample``).
+
+Cost: O(samples x modes x points) for the march over the output grid, O(nodes x modes) for
+the load nodes (one damped-oscillator transition per node and mode), O(pieces) mode-shape
+evaluations. Memory: the three (points, samples) outputs, O(nodes) node tables, and the mode
+shapes of at most ``batch_nodes`` pieces at a time: never (modes x samples) or
+(nodes x pieces).
+"""
+
+import math
+import time
+
+import numpy as np
+
+from tailbeam.contact_patch import disc_rule
+from tailbeam.coupled.load_kernel import add_particular, empty_outputs, march, transition
+from tailbeam.errors import InputError, WorkLimitError
+from tailbeam.plate.model import check_points
+from tailbeam.progress import note, task
+
+BATCH_NODES = 4096  # load nodes per batch (bounds the mode-shape table: batch x modes)
+DISC_BATCH = 256  # load discs evaluated per basis call (48 points each)
+MAX_BYTES = 2e9  # memory bound of plate_response (outputs + node tables + shapes)
+MAX_QUASI_STATIC_S = 600.0  # time bound of the residual cross compliances
+
+
+def plate_response(
+    basis,
+    zeta,
+    loads,
+    points,
+    times,
+    *,
+    load_radius: float = 0.0,
+    quasi_static: bool = True,
+    batch_nodes: int = BATCH_NODES,
+    max_bytes: float = MAX_BYTES,
+) -> dict:
+    """Plate deflection "w" (m, + up), velocity "v" (m/s) and acceleration "a" (m/s^2) at
+    ``points`` under ``loads``, each (p, len(times)).
+
+    Parameters
+    ----------
+    basis : ModalBasis
+        The plate's kept modes (frequencies, mass-normalised shapes).
+    zeta : float or (n_modes,) array
+        Modal damping ratios, each in [0, 1).
+    loads : PlateLoads
+        The load pieces (N, pressing down); the plate is at rest before the first one.
+    points : (p, 2) array
+        Where the plate is observed, m (plate frame, centred on the origin).
+    times : (N,) array
+        Uniform sample times, s (spacing equal to 1e-9 relative; taken as t0 + j dt).
+    load_radius : float
+        Radius (m) of the disc a piece without its own radius is spread over (0: a point
+        load, the Kirchhoff model; see tailbeam.contact_patch).
+    quasi_static : bool
+        Add the truncated modes' quasi-static response -R F(t) at the points (R: the
+        basis' residual cross compliance; velocity and acceleration as central differences
+        at the sample spacing, as ``CoupledResult.quasi_static_sample``). Ignored, with a
+        note, if the basis has no static cross compliance.
+    batch_nodes, max_bytes : int, float
+        Load nodes per batch of mode shapes; memory bound (bytes, WorkLimitError above it).
+    """
+    pts = check_points(basis.plate, points, "points")
+    t0, dt, n_samples = uniform_times(times)
+    omega = np.ascontiguousarray(basis.omega, dtype=float)
+    zeta = _zeta(zeta, omega.shape[0])
+    xyr = _load_points(basis, loads, load_radius)
+    nodes = node_jumps(loads, t0, dt, n_samples)
+    _check_memory(len(pts), n_samples, loads, omega.shape[0], batch_nodes, max_bytes)
+    phi_pts = np.ascontiguousarray(basis.deflection(pts), dtype=float)
+    out = empty_outputs(len(pts), n_samples)
+    g, h, seen = _march_all(
+        basis, omega, zeta, xyr, nodes, phi_pts, n_samples, dt, batch_nodes, out
+    )
+    r = np.zeros_like(g)
+    if quasi_static:
+        r = _residual(basis, xyr, pts, seen)
+    target = nodes["target"]
+    span = target[nodes["last"]] - target[loads.first]
+    buf = np.empty(int(np.max(span, initial=0)) + 4)
+    add_particular(t0, dt, loads.t, loads.force, loads.first, nodes["last"], target, g, h, r, buf,
+                   *out)  # fmt: skip
+    return dict(zip(("w", "v", "a"), out, strict=True))
+
+
+def uniform_times(times) -> tuple:
+    """(t0 s, dt s, N) of uniform sorted ``times`` (N >= 2, spacing equal to 1e-9 relative)."""
+    t = np.asarray(times, dtype=float)
+    if t.ndim != 1 or t.size < 2 or not np.all(np.isfinite(t)):
+        raise InputError("times", "must be a 1-D array of >= 2 finite times in s")
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    if not dt > 0 or np.max(np.abs(np.diff(t) - dt)) > 1e-9 * dt:
+        raise InputError("times", "must be uniform and increasing (the sensor grid)")
+    return float(t[0]), float(dt), int(t.size)
+
+
+def _zeta(zeta, n):
+    z = np.ascontiguousarray(np.broadcast_to(np.asarray(zeta, dtype=float), (n,)))
+    if not np.all((z >= 0.0) & (z < 1.0)):
+        raise InputError("zeta", "modal damping ratios must lie in [0, 1)")
+    return z
+
+
+def _load_points(basis, loads, load_radius) -> np.ndarray:
+    """(pieces, 3) x, y, radius (m) of every piece, default radius filled in; checked."""
+    if not (math.isfinite(load_radius) and load_radius >= 0.0):
+        raise InputError("load_radius", f"must be >= 0 m, got {load_radius!r}")
+    xyr = np.column_stack([loads.x, loads.y, loads.radius])
+    xyr[np.isnan(xyr[:, 2]), 2] = load_radius
+    if len(xyr):
+        half = 0.5 * np.array([basis.plate.size_x, basis.plate.size_y]) * (1 + 1e-9)
+        off = np.flatnonzero(np.any(np.abs(xyr[:, :2]) > half, axis=1))
+        if off.size:
+            i = int(off[0])
+            raise InputError(
+                f"loads[{i}]", f"point ({xyr[i, 0]:.6g}, {xyr[i, 1]:.6g}) m is not on the plate"
+            )
+    return xyr
+
+
+def node_jumps(loads, t0: float, dt: float, n_samples: int) -> dict:
+    """Per load node: the jump of the load's value "df" (N) and slope "ds" (N/s) there, its
+    "target" sample (the first at or after it; 0 for nodes before t0; n_samples after the
+    last) and "delta" = target time - node time (s); per piece its "last" node index."""
+    t, f, first = loads.t, loads.force, loads.first
+    n = t.size
+    last = np.append(first[1:], n) - 1
+    is_first = np.zeros(n, dtype=bool)
+    is_last = np.zeros(n, dtype=bool)
+    is_first[first] = True
+    is_last[last] = True
+    span = np.diff(t)
+    inside = ~is_last[:-1] & (span > 0.0)
+    slope = np.zeros(n)
+    slope[:-1][inside] = (f[1:] - f[:-1])[inside] / span[inside]
+    slope_before = np.zeros(n)
+    slope_before[1:] = slope[:-1]
+    slope_before[is_first] = 0.0
+    df = np.where(is_last, 0.0, f) - np.where(is_first, 0.0, f)
+    u = np.ceil((t - t0) / dt)
+    target = np.clip(u, 0, n_samples).astype(np.int64)
+    delta = (t0 + target * dt) - t
+    return {
+        "df": df,
+        "ds": slope - slope_before,
+        "target": target,
+        "delta": delta,
+        "last": last,
+        "piece": loads.piece_of_node(),
+    }
+
+
+def _march_all(basis, omega, zeta, xyr, nodes, phi_pts, n_samples, dt, batch_nodes, out):
+    """Run ``march`` over all samples, the nodes in batches of ``batch_nodes`` (their pieces'
+    mode shapes evaluated per batch). Returns G, H (pieces, p) and which pieces were seen."""
+    n_pieces = xyr.shape[0]
+    g = np.zeros((n_pieces, phi_pts.shape[0]))
+    h = np.zeros_like(g)
+    seen = np.zeros(n_pieces, dtype=bool)
+    mu = omega * np.sqrt(1.0 - zeta**2)
+    zw = zeta * omega
+    w2 = omega**2
+    pdt = np.empty((4, omega.shape[0]))
+    transition(mu, zw, w2, dt, pdt)
+    qh, vh = np.zeros(omega.shape[0]), np.zeros(omega.shape[0])
+    g_pts = (phi_pts / w2).T
+    h_pts = (phi_pts * (2.0 * zeta / omega**3)).T
+    order = _active_nodes(nodes, n_samples)
+    piece = nodes["piece"]
+    tg = nodes["target"][order]
+    done = -1
+    with task("plate response at the sensors", total=max(order.size, 1), unit="load nodes") as bar:
+        start = 0
+        while start < order.size:
+            stop = min(start + batch_nodes, order.size)
+            stop = int(np.searchsorted(tg, tg[stop - 1], side="right"))  # whole samples
+            sel = order[start:stop]
+            uniq, rows = np.unique(piece[sel], return_inverse=True)
+            phi_tab = load_shapes(basis, xyr[uniq])
+            g[uniq], h[uniq], seen[uniq] = phi_tab @ g_pts, phi_tab @ h_pts, True
+            args = (nodes["delta"][sel], rows.ravel().astype(np.int64))
+            march(done + 1, int(tg[stop - 1]), pdt, mu, zw, w2, qh, vh, phi_pts, tg[start:stop],
+                  *args, nodes["df"][sel], nodes["ds"][sel], phi_tab, *out)  # fmt: skip
+            done = int(tg[stop - 1])
+            bar.update(stop - start)
+            start = stop
+        empty_i, empty_f = np.zeros(0, dtype=np.int64), np.zeros(0)
+        march(done + 1, n_samples - 1, pdt, mu, zw, w2, qh, vh, phi_pts, empty_i, empty_f,
+              empty_i, empty_f, empty_f, np.zeros((1, omega.shape[0])), *out)  # fmt: skip
+    return g, h, seen
+
+
+def _active_nodes(nodes, n_samples):
+    """Indices of the nodes that act on a sample (target < n_samples, a jump), by target."""
+    act = (nodes["target"] < n_samples) & ((nodes["df"] != 0.0) | (nodes["ds"] != 0.0))
+    idx = np.flatnonzero(act)
+    return idx[np.argsort(nodes["target"][idx], kind="stable")]
+
+
+def load_shapes(basis, xyr) -> np.ndarray:
+    """(k, n_modes) mode shapes under the loads xyr (k, 3) (x, y m; radius m: 0 a point,
+    else the mean over the disc, as ModalBasis.load_deflection); each distinct load once."""
+    uniq, inv = np.unique(xyr, axis=0, return_inverse=True)
+    out = np.empty((uniq.shape[0], basis.n_modes))
+    point = uniq[:, 2] == 0.0
+    if point.any():
+        out[point] = basis.deflection(uniq[point, :2])
+    disc = np.flatnonzero(~point)
+    for k in range(0, disc.size, DISC_BATCH):
+        rules = [disc_rule(basis.plate, uniq[i, :2], uniq[i, 2]) for i in disc[k : k + DISC_BATCH]]
+        pts = np.concatenate([rule[0] for rule in rules])
+        wts = np.concatenate([rule[1] for rule in rules])
+        starts = np.cumsum([0] + [len(rule[1]) for rule in rules[:-1]])
+        rows = basis.deflection(pts) * wts[:, None]
+        out[disc[k : k + DISC_BATCH]] = np.add.reduceat(rows, starts, axis=0)
+    return np.ascontiguousarray(out[inv.ravel()])
+
+
+def _residual(basis, xyr, pts, seen) -> np.ndarray:
+    """R (pieces, p): the residual cross compliance (m/N) of each seen piece's load at the
+    points (ModalBasis.residual_cross_compliance), each distinct load once; zeros (with a
+    note) if the basis has none. WorkLimitError if it would take over MAX_QUASI_STATIC_S."""
+    r = np.zeros((xyr.shape[0], pts.shape[0]))
+    if getattr(basis, "static_deflection_at", None) is None:
+        note(f"no quasi-static correction: the {basis.theory} basis has no static compliance")
+        return r
+    idx = np.flatnonzero(seen)
+    if idx.size == 0:
+        return r
+    uniq, inv = np.unique(xyr[idx], axis=0, return_inverse=True)
+    values = np.empty((uniq.shape[0], pts.shape[0]))
+    with task("quasi-static correction", total=uniq.shape[0], unit="load points") as bar:
+        for k, (x, y, rad) in enumerate(uniq):
+            start = time.perf_counter()
+            values[k] = basis.residual_cross_compliance((x, y), pts, rad)
+            if k == 0:
+                _check_residual_time(time.perf_counter() - start, uniq.shape[0])
+            bar.update(1)
+    r[idx] = values[inv.ravel()]
+    return r
+
+
+def _check_residual_time(seconds_one, count):
+    estimate = seconds_one * count
+    if estimate > MAX_QUASI_STATIC_S:
+        raise WorkLimitError(
+            f"quasi_static: the residual cross compliance at {count} distinct load points would "
+            f"take ~{estimate:.0f} s ({seconds_one * 1e3:.1f} ms each with this basis, limit "
+            f"{MAX_QUASI_STATIC_S:.0f} s); pass quasi_static=False (kept modes only)"
+        )
+
+
+def _check_memory(n_points, n_samples, loads, n_modes, batch_nodes, max_bytes):
+    need = 8 * (3 * n_points * n_samples + 8 * loads.n_nodes + 2 * batch_nodes * n_modes)
+    if need > max_bytes:
+        raise WorkLimitError(
+            f"max_bytes: the plate response needs ~{need / 1e9:.2f} GB ({n_points} points x "
+            f"{n_samples} samples, {loads.n_nodes} load nodes), above {max_bytes / 1e9:.2f} GB;"
+            " use fewer samples or points per call, or raise max_bytes"
+        )
