@@ -106,8 +106,7 @@ def add_particular(t0, dt, t, force, first, last, target, G, H, R, buf, out_w, o
     """Add every load's particular part (through G, H (loads, p)) and its quasi-static
     residual response (R (loads, p), m/N; zeros for none) at the points. Loads are the node
     ranges first[l]..last[l] (inclusive) of t (s) and force (N); target (nodes,) the sample of
-    each node; buf a scratch array of at least any load's span in samples + 4. The
-    residual's differences take the force as zero before the first sample."""
+    each node; buf a scratch array of at least any load's span in samples + 4."""
     n_samples = out_w.shape[1]
     n_pts = out_w.shape[0]
     for ld in range(first.shape[0]):
@@ -115,9 +114,9 @@ def add_particular(t0, dt, t, force, first, last, target, G, H, R, buf, out_w, o
         jb = min(target[last[ld]], n_samples)
         if ja >= n_samples:
             continue
-        # the force at samples ja..jb-1 in buf[2 + j - ja], zero on both sides (two samples)
+        # the force at samples ja-1..jb in buf[2 + j - ja] (zero beyond, buf[0] = 0)
         buf[0] = 0.0
-        buf[1] = 0.0
+        buf[1] = _force_at(t0 - dt, t, force, first[ld], last[ld]) if ja == 0 else 0.0
         for k in range(first[ld], last[ld]):
             lo = max(target[k], 0)
             hi = min(target[k + 1], n_samples)
@@ -131,7 +130,7 @@ def add_particular(t0, dt, t, force, first, last, target, G, H, R, buf, out_w, o
                 for p in range(n_pts):
                     out_w[p, j] -= f * G[ld, p] - slope * H[ld, p]
                     out_v[p, j] -= slope * G[ld, p]
-        buf[2 + jb - ja] = 0.0
+        buf[2 + jb - ja] = _force_at(t0 + jb * dt, t, force, first[ld], last[ld])
         buf[3 + jb - ja] = 0.0
         for j in range(max(ja - 1, 0), min(jb + 1, n_samples)):
             fm, f0, fp = buf[1 + j - ja], buf[2 + j - ja], buf[3 + j - ja]
@@ -142,6 +141,18 @@ def add_particular(t0, dt, t, force, first, last, target, G, H, R, buf, out_w, o
                     out_v[p, j] -= r * (fp - fm) / (2.0 * dt)
                     out_a[p, j] -= r * (fp - 2.0 * f0 + fm) / (dt * dt)
     return 0
+
+
+@njit(cache=True)
+def _force_at(time, t, force, first, last):
+    """The force (N) of the load with nodes first..last at ``time`` s (right-continuous, zero
+    outside [t[first], t[last]))."""
+    if time < t[first] or time >= t[last]:
+        return 0.0
+    k = first
+    while t[k + 1] <= time:
+        k += 1
+    return force[k] + (force[k + 1] - force[k]) * (time - t[k]) / (t[k + 1] - t[k])
 
 
 def empty_outputs(n_points, n_samples):

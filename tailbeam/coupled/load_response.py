@@ -268,3 +268,36 @@ def _check_memory(n_points, n_samples, loads, n_modes, batch_nodes, max_bytes):
             f"{n_samples} samples, {loads.n_nodes} load nodes), above {max_bytes / 1e9:.2f} GB;"
             " use fewer samples or points per call, or raise max_bytes"
         )
+
+
+def sensor_outputs(basis, zeta, loads, sensors, duration, *, load_radius=0.0, quasi_static=True):
+    """name -> tailbeam.sensor.SensorOutput for every sensor (SensorSpec) under ``loads``:
+    the chain of ``CoupledResult.sensor_outputs`` (true acceleration on the sensor's fine grid,
+    mounted resonance, anti-alias FIR, sampling, noise) over [0, duration] s, driven by
+    ``plate_response``. Sensors whose fine grids coincide share one plate response.
+    ``sensor_signals(outputs)`` gives what ``write_sensors_csv`` takes."""
+    from tailbeam.sensor import measure
+
+    f_top = float(np.max(basis.frequencies_hz))
+    positions = np.array([s.position for s in sensors], dtype=float).reshape(-1, 2)
+    done = {}
+
+    def acceleration(times, index):
+        key = (len(times), float(times[1] - times[0]))
+        if key not in done:
+            response = plate_response(
+                basis, zeta, loads, positions, times,
+                load_radius=load_radius, quasi_static=quasi_static,
+            )  # fmt: skip
+            done[key] = response["a"]
+        return done[key][index]
+
+    return {
+        s.name: measure(s, lambda t, i=i: acceleration(t, i), duration, max_frequency_hz=f_top)
+        for i, s in enumerate(sensors)
+    }
+
+
+def sensor_signals(outputs: dict) -> dict:
+    """name -> (t s, acceleration m/s^2) of ``sensor_outputs`` (for write_sensors_csv)."""
+    return {name: (out.t, out.acceleration) for name, out in outputs.items()}
