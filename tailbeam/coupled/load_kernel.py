@@ -65,6 +65,9 @@ def march(
                 qh[i] = pdt[0, i] * q + pdt[1, i] * v
                 vh[i] = pdt[2, i] * q + pdt[3, i] * v
         while kp < nk and k_target[kp] == j:
+            if k_df[kp] == 0.0 and k_ds[kp] == 0.0:
+                kp += 1
+                continue
             _add_jump(mu, zw, w2, qh, vh, k_delta[kp], phi_tab[k_row[kp]], k_df[kp], k_ds[kp])
             kp += 1
         for p in range(phi_pts.shape[0]):
@@ -140,6 +143,27 @@ def add_particular(t0, dt, t, force, first, last, target, G, H, R, buf, out_w, o
                     out_w[p, j] -= r * f0
                     out_v[p, j] -= r * (fp - fm) / (2.0 * dt)
                     out_a[p, j] -= r * (fp - 2.0 * f0 + fm) / (dt * dt)
+    return 0
+
+
+@njit(cache=True)
+def jumps_kernel(t, force, first, last, t0, dt, n_samples, df, ds, target):
+    """Fill df (N), ds (N/s): the jumps of each node's load value and slope (the load is zero
+    outside its nodes, linear between them), and target: the first sample at or after the
+    node (clipped to 0..n_samples)."""
+    for ld in range(first.shape[0]):
+        slope_before = 0.0
+        for k in range(first[ld], last[ld] + 1):
+            left = force[k] if k > first[ld] else 0.0
+            right = force[k] if k < last[ld] else 0.0
+            slope = 0.0
+            if k < last[ld] and t[k + 1] > t[k]:
+                slope = (force[k + 1] - force[k]) / (t[k + 1] - t[k])
+            df[k] = right - left
+            ds[k] = slope - slope_before
+            slope_before = slope
+            u = math.ceil((t[k] - t0) / dt)
+            target[k] = int(min(max(u, 0.0), float(n_samples)))
     return 0
 
 

@@ -21,7 +21,13 @@ import time
 import numpy as np
 
 from tailbeam.contact_patch import disc_rule
-from tailbeam.coupled.load_kernel import add_particular, empty_outputs, march, transition
+from tailbeam.coupled.load_kernel import (
+    add_particular,
+    empty_outputs,
+    jumps_kernel,
+    march,
+    transition,
+)
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.plate.model import check_points
 from tailbeam.progress import note, task
@@ -76,13 +82,12 @@ def plate_response(
     omega = np.ascontiguousarray(basis.omega, dtype=float)
     zeta = _zeta(zeta, omega.shape[0])
     xyr = _load_points(basis, loads, load_radius)
-    nodes = node_jumps(loads, t0, dt, n_samples)
     _check_memory(len(pts), n_samples, loads, omega.shape[0], batch_nodes, max_bytes)
+    nodes = node_jumps(loads, t0, dt, n_samples)
     phi_pts = np.ascontiguousarray(basis.deflection(pts), dtype=float)
     out = empty_outputs(len(pts), n_samples)
-    g, h, seen = _march_all(
-        basis, omega, zeta, xyr, nodes, phi_pts, n_samples, dt, batch_nodes, out
-    )
+    grid = (t0, dt, n_samples)
+    g, h, seen = _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, grid, batch_nodes, out)
     r = np.zeros_like(g)
     if quasi_static:
         r = _residual(basis, xyr, pts, seen, g)
@@ -130,41 +135,22 @@ def _load_points(basis, loads, load_radius) -> np.ndarray:
 
 
 def node_jumps(loads, t0: float, dt: float, n_samples: int) -> dict:
-    """Per load node: the jump of the load's value "df" (N) and slope "ds" (N/s) there, its
+    """Per load node: the jump of the load's value "df" (N) and slope "ds" (N/s) there and its
     "target" sample (the first at or after it; 0 for nodes before t0; n_samples after the
-    last) and "delta" = target time - node time (s); per piece its "last" node index."""
-    t, f, first = loads.t, loads.force, loads.first
-    n = t.size
-    last = np.append(first[1:], n) - 1
-    is_first = np.zeros(n, dtype=bool)
-    is_last = np.zeros(n, dtype=bool)
-    is_first[first] = True
-    is_last[last] = True
-    span = np.diff(t)
-    inside = ~is_last[:-1] & (span > 0.0)
-    slope = np.zeros(n)
-    slope[:-1][inside] = (f[1:] - f[:-1])[inside] / span[inside]
-    slope_before = np.zeros(n)
-    slope_before[1:] = slope[:-1]
-    slope_before[is_first] = 0.0
-    df = np.where(is_last, 0.0, f) - np.where(is_first, 0.0, f)
-    u = np.ceil((t - t0) / dt)
-    target = np.clip(u, 0, n_samples).astype(np.int64)
-    delta = (t0 + target * dt) - t
-    return {
-        "df": df,
-        "ds": slope - slope_before,
-        "target": target,
-        "delta": delta,
-        "last": last,
-        "piece": loads.piece_of_node(),
-    }
+    last); per piece its "last" node. (tailbeam.coupled.load_kernel.node_jumps)"""
+    n = loads.n_nodes
+    last = np.append(loads.first[1:], n).astype(np.int64) - 1
+    df, ds, target = np.empty(n), np.empty(n), np.empty(n, dtype=np.int64)
+    jumps_kernel(loads.t, loads.force, loads.first, last, t0, dt, n_samples, df, ds, target)
+    return {"df": df, "ds": ds, "target": target, "last": last}
 
 
-def _march_all(basis, omega, zeta, xyr, nodes, phi_pts, n_samples, dt, batch_nodes, out):
+def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batch_nodes, out):
     """Run ``march`` over all samples, the nodes in batches of ``batch_nodes`` (their pieces'
     mode shapes evaluated per batch). Returns G, H (pieces, p) and which pieces were seen."""
     n_pieces = xyr.shape[0]
+    t0, dt, n_samples = times
+    t_nodes, first = loads.t, loads.first
     g = np.zeros((n_pieces, phi_pts.shape[0]))
     h = np.zeros_like(g)
     seen = np.zeros(n_pieces, dtype=bool)
@@ -176,36 +162,33 @@ def _march_all(basis, omega, zeta, xyr, nodes, phi_pts, n_samples, dt, batch_nod
     qh, vh = np.zeros(omega.shape[0]), np.zeros(omega.shape[0])
     g_pts = (phi_pts / w2).T
     h_pts = (phi_pts * (2.0 * zeta / omega**3)).T
-    order = _active_nodes(nodes, n_samples)
-    piece = nodes["piece"]
-    tg = nodes["target"][order]
+    order = np.argsort(nodes["target"], kind="stable")
+    n_act = int(np.searchsorted(nodes["target"], n_samples, sorter=order))
     done = -1
-    with task("plate response at the sensors", total=max(order.size, 1), unit="load nodes") as bar:
+    with task("plate response at the sensors", total=max(n_act, 1), unit="load nodes") as bar:
         start = 0
-        while start < order.size:
-            stop = min(start + batch_nodes, order.size)
-            stop = int(np.searchsorted(tg, tg[stop - 1], side="right"))  # whole samples
+        while start < n_act:
+            stop = min(start + batch_nodes, n_act)
+            last_j = int(nodes["target"][order[stop - 1]])
+            while stop < n_act and nodes["target"][order[stop]] == last_j:  # whole samples
+                stop += 1
             sel = order[start:stop]
-            uniq, rows = np.unique(piece[sel], return_inverse=True)
+            pieces = np.searchsorted(first, sel, side="right") - 1
+            uniq, rows = np.unique(pieces, return_inverse=True)
             phi_tab = load_shapes(basis, xyr[uniq])
             g[uniq], h[uniq], seen[uniq] = phi_tab @ g_pts, phi_tab @ h_pts, True
-            args = (nodes["delta"][sel], rows.ravel().astype(np.int64))
-            march(done + 1, int(tg[stop - 1]), pdt, mu, zw, w2, qh, vh, phi_pts, tg[start:stop],
-                  *args, nodes["df"][sel], nodes["ds"][sel], phi_tab, *out)  # fmt: skip
-            done = int(tg[stop - 1])
+            tg = nodes["target"][sel]
+            delta = (t0 + tg * dt) - t_nodes[sel]
+            march(done + 1, last_j, pdt, mu, zw, w2, qh, vh, phi_pts, tg, delta,
+                  rows.ravel().astype(np.int64), nodes["df"][sel], nodes["ds"][sel], phi_tab,
+                  *out)  # fmt: skip
+            done = last_j
             bar.update(stop - start)
             start = stop
         empty_i, empty_f = np.zeros(0, dtype=np.int64), np.zeros(0)
         march(done + 1, n_samples - 1, pdt, mu, zw, w2, qh, vh, phi_pts, empty_i, empty_f,
               empty_i, empty_f, empty_f, np.zeros((1, omega.shape[0])), *out)  # fmt: skip
     return g, h, seen
-
-
-def _active_nodes(nodes, n_samples):
-    """Indices of the nodes that act on a sample (target < n_samples, a jump), by target."""
-    act = (nodes["target"] < n_samples) & ((nodes["df"] != 0.0) | (nodes["ds"] != 0.0))
-    idx = np.flatnonzero(act)
-    return idx[np.argsort(nodes["target"][idx], kind="stable")]
 
 
 def load_shapes(basis, xyr) -> np.ndarray:
@@ -281,7 +264,8 @@ def _check_residual_time(seconds_one, count):
 
 
 def _check_memory(n_points, n_samples, loads, n_modes, batch_nodes, max_bytes):
-    need = 8 * (3 * n_points * n_samples + 8 * loads.n_nodes + 2 * batch_nodes * n_modes)
+    # outputs; per node df, ds, target, sort order (+ argsort scratch); two shape tables
+    need = 8 * (3 * n_points * n_samples + 5 * loads.n_nodes + 2 * batch_nodes * n_modes)
     if need > max_bytes:
         raise WorkLimitError(
             f"max_bytes: the plate response needs ~{need / 1e9:.2f} GB ({n_points} points x "
