@@ -298,3 +298,18 @@ def test_quasi_static_on_an_fe_mindlin_basis_with_load_discs():
         ref = basis.residual_cross_compliance((x, y), POINTS, rad)
         assert np.max(np.abs(row - ref)) < 1e-9 * np.max(np.abs(ref))
         assert np.all(np.abs(ref) > 0.0)
+
+
+def test_a_window_of_the_grid_equals_the_same_samples_of_the_whole_grid(basis):
+    # loads that start before the first sample (propagated to it) or end after the last
+    # (cut): any window of the grid gives the samples of the whole grid, correction included
+    times = np.arange(3000) * DT
+    loads = PlateLoads()
+    loads.add_contact(0.11, -0.07, *half_sine(0.0081, 2.5e-4, 1500.0))
+    loads.add_contact(-0.2, 0.05, *half_sine(0.0175, 3e-4, 900.0))
+    loads.add_dead_load(0.05, 0.2, 0.004, 0.02, 60.0)
+    whole = plate_response(basis, 0.01, loads, POINTS, times)
+    cut = slice(1070, 2310)  # inside the first contact ... inside the second
+    window = plate_response(basis, 0.01, loads, POINTS, times[cut])
+    for key in "wva":
+        assert rel_err(window[key], whole[key][:, cut]) < 1e-12, key
