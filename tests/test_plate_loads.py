@@ -62,6 +62,27 @@ def test_one_contact_equals_dense_replay(basis):
         assert rel_err(ours[key], ref[key]) < 1e-12, key
 
 
+@pytest.mark.parametrize("t_offset", [0.0, 5.3])
+def test_many_nodes_per_sample_equal_dense_replay(basis, t_offset):
+    # 400 nodes over 0.25 ms: ~12 per sample interval, chained with shared node steps. At
+    # t ~ 5.3 s the rounded node times' steps differ by ~1 ulp (8.9e-16 s): node_time_ulps=0
+    # places every node exactly; the default 2 ulps moves a node by <= 1.8e-15 s, a phase of
+    # <= 1.1e-10 rad at the top mode (10 kHz)
+    times = t_offset + np.arange(4000) * DT
+    tn, f = half_sine(t_offset + 0.0011, 2.5e-4, 1500.0, n=400)
+    loads = PlateLoads()
+    loads.add_contact(0.11, -0.07, tn, f)
+    dense_t = np.concatenate([[t_offset], tn])
+    dense_f = np.concatenate([[0.0], f])[:, None]
+    ref = forced_response(basis, [[0.11, -0.07]], dense_t, dense_f, times, POINTS)
+    exact = plate_response(basis, 0.01, loads, POINTS, times, quasi_static=False, node_time_ulps=0)
+    chained = plate_response(basis, 0.01, loads, POINTS, times, quasi_static=False)
+    phase = 2 * np.pi * 1e4 * 2 * np.spacing(t_offset + 0.0011)
+    for key in "wva":
+        assert rel_err(exact[key], ref[key]) < 1e-12, key
+        assert rel_err(chained[key], ref[key]) < max(1e-12, 2 * phase), key
+
+
 def test_overlapping_loads_equal_dense_replay_and_batches_do_not_matter(basis):
     # two contacts overlapping in time and a dead load across both, at three points; the
     # dense replay takes them as three force columns on the union of their node times

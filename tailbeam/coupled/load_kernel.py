@@ -10,8 +10,10 @@ f = -phi_load F). Between jumps h is a free damped oscillation, propagated exact
 transition matrix P(tau) (closed form, zeta < 1). So:
 
 - ``march``: h at every output sample (one P(dt) per sample and mode), each load node's jump
-  propagated from the node to the next sample (one P(delta) per node and mode); the plate at
-  the points from h alone, and its acceleration exactly: q'' = h'' (q_p'' = 0).
+  propagated from the node to the next sample: a load's nodes within one sample interval are
+  chained (acc <- P(gap) acc + J, P(gap) shared while the node steps are equal), then one
+  P(delta) per load, sample and mode; the plate at the points from h alone, and its
+  acceleration exactly: q'' = h'' (q_p'' = 0).
 - ``add_particular``: per load, the particular part at the points over the samples the load
   acts on (its static-like part through the precomputed G = sum phi(P) phi_load/omega^2 and
   H = sum phi(P) phi_load 2 zeta/omega^3), and the truncated modes' quasi-static response
@@ -26,6 +28,8 @@ import math
 
 import numpy as np
 from numba import njit
+
+EPS = 2.220446049250313e-16  # float64 machine epsilon
 
 
 @njit(cache=True)
@@ -45,16 +49,19 @@ def transition(mu, zw, w2, tau, out):
 
 @njit(cache=True)
 def march(
-    j_from, j_to, pdt, mu, zw, w2, qh, vh, phi_pts, k_target, k_delta, k_row, k_df, k_ds,
-    phi_tab, out_w, out_v, out_a,
+    j_from, j_to, t0, dt, pdt, mu, zw, w2, qh, vh, phi_pts, k_target, k_time, k_row, k_df, k_ds,
+    phi_tab, ulps, out_w, out_v, out_a,
 ):  # fmt: skip
     """Advance the homogeneous state (qh, vh) (n,), given at sample j_from - 1, through samples
-    j_from..j_to (inclusive), adding the jumps of the load nodes targeted there (sorted by
-    k_target; k_delta = sample time - node time s, k_row the node's row of phi_tab (rows, n),
-    k_df, k_ds the jumps of the load's value (N) and slope (N/s) there), and write the points'
-    homogeneous deflection, velocity and (exact) acceleration into out_* (p, samples).
-    Returns the number of nodes consumed."""
+    j_from..j_to (inclusive) of the grid t0 + j dt (s), adding the jumps of the load nodes
+    targeted there (sorted by k_target, a load's nodes in time order; k_time the node time s,
+    k_row the node's row of phi_tab (rows, n), k_df, k_ds the jumps of the load's value (N)
+    and slope (N/s) there; ``ulps``: see _run_jumps), and write the points' homogeneous
+    deflection, velocity and (exact) acceleration into out_* (p, samples). Returns the number
+    of nodes consumed."""
     n = mu.shape[0]
+    acc = np.empty((2, n))
+    pg = np.empty((4, n))
     kp = 0
     nk = k_target.shape[0]
     for j in range(j_from, j_to + 1):
@@ -65,11 +72,14 @@ def march(
                 qh[i] = pdt[0, i] * q + pdt[1, i] * v
                 vh[i] = pdt[2, i] * q + pdt[3, i] * v
         while kp < nk and k_target[kp] == j:
-            if k_df[kp] == 0.0 and k_ds[kp] == 0.0:
-                kp += 1
-                continue
-            _add_jump(mu, zw, w2, qh, vh, k_delta[kp], phi_tab[k_row[kp]], k_df[kp], k_ds[kp])
-            kp += 1
+            ke = kp + 1  # the run of this load's nodes in this sample
+            while ke < nk and k_target[ke] == j and k_row[ke] == k_row[kp]:
+                ke += 1
+            if ke - kp > 1 or k_df[kp] != 0.0 or k_ds[kp] != 0.0:
+                phi_load = phi_tab[k_row[kp]]
+                tau = _run_jumps(mu, zw, w2, k_time, k_df, k_ds, kp, ke, phi_load, ulps, acc, pg)
+                _add_propagated(mu, zw, w2, qh, vh, (t0 + j * dt) - tau, acc)
+            kp = ke
         for p in range(phi_pts.shape[0]):
             w = 0.0
             v = 0.0
@@ -86,13 +96,52 @@ def march(
 
 
 @njit(cache=True)
-def _add_jump(mu, zw, w2, qh, vh, delta, phi_load, d_f, d_s):
-    """Add one node's jump of the homogeneous part, propagated over ``delta`` s: dF (N) and dS
-    (N/s) are the jumps of the load's value and slope at the node."""
+def _run_jumps(mu, zw, w2, k_time, k_df, k_ds, a, b, phi_load, ulps, acc, pg):
+    """acc (2, n) = the homogeneous jumps of one load's nodes a..b-1 (time order), chained:
+    acc <- P(gap) acc + J at each node; returns the time (s) acc refers to. P(gap) is reused
+    while the step from that time to the next node is within ``ulps`` ulps (of the node time)
+    of the last computed one (equal node steps whose times were rounded): each node's jump is
+    then placed within ``ulps`` ulps of its time, never drifting along the run; ulps = 0
+    places every node exactly (a transition matrix per node whose step differs)."""
+    n = mu.shape[0]
+    last_gap = -1.0
+    tau = k_time[a]
+    for k in range(a, b):
+        if k > a:
+            gap = k_time[k] - tau
+            if abs(gap - last_gap) > ulps * EPS * abs(k_time[k]):
+                transition(mu, zw, w2, gap, pg)
+                last_gap = gap
+                tau = k_time[k]
+            else:
+                tau += last_gap
+            for i in range(n):
+                q = acc[0, i]
+                v = acc[1, i]
+                acc[0, i] = pg[0, i] * q + pg[1, i] * v
+                acc[1, i] = pg[2, i] * q + pg[3, i] * v
+        d_f = k_df[k]
+        d_s = k_ds[k]
+        for i in range(n):
+            inv_w2 = 1.0 / w2[i]
+            dq = phi_load[i] * (d_f - 2.0 * zw[i] * inv_w2 * d_s) * inv_w2
+            dv = phi_load[i] * d_s * inv_w2
+            if k == a:
+                acc[0, i] = dq
+                acc[1, i] = dv
+            else:
+                acc[0, i] += dq
+                acc[1, i] += dv
+    return tau
+
+
+@njit(cache=True)
+def _add_propagated(mu, zw, w2, qh, vh, delta, acc):
+    """(qh, vh) += P(delta) acc: jumps at a node time, propagated over ``delta`` s to the
+    sample."""
     for i in range(mu.shape[0]):
-        inv_w2 = 1.0 / w2[i]
-        dq = phi_load[i] * (d_f - 2.0 * zw[i] * inv_w2 * d_s) * inv_w2
-        dv = phi_load[i] * d_s * inv_w2
+        dq = acc[0, i]
+        dv = acc[1, i]
         if delta == 0.0:
             qh[i] += dq
             vh[i] += dv
