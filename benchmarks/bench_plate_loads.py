@@ -177,7 +177,7 @@ def main(out_dir, quick=False):
         rows = baseline_row(basis, 25, quick)
         for row in rows:
             print(_line(row), f"dense table {row['dense_table_MB']:.1f} MB", flush=True)
-        rows += full_rows(basis, [10, 25] if quick else [10, 25, 50, 100], quick)
+        rows += full_rows(basis, [10, 25] if quick else [10, 25, 50, 100, 200], quick)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     keys = list(dict.fromkeys(k for row in rows for k in row))
