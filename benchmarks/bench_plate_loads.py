@@ -20,7 +20,8 @@ Rows:
 3. the full case with the quasi-static (residual) correction on (25 nodes per contact): its
    extra cost is one static deflection per distinct load point and sensor (this basis: the
    Navier double series, ~1 ms per point), reported separately;
-4. the full case through the whole sensor chain (sensor_outputs), wall time and peak memory.
+4. the full case through the whole sensor chain (sensor_outputs), wall time and peak memory;
+   its records are drawn in DIR/sensor_s1.png, sensor_s2.png (tailbeam.sensor_figures).
 Rows 1-2 and 4 have the correction off.
 Writes DIR/bench_plate_loads.csv and DIR/table.md. Run single-threaded (OMP_NUM_THREADS=1).
 """
@@ -41,6 +42,7 @@ from tailbeam.coupled.loads import PlateLoads
 from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.progress import quiet
 from tailbeam.scene import SensorSpec
+from tailbeam.sensor_figures import sensor_figures
 
 FMAX = 10000.0
 ZETA = 0.01
@@ -151,7 +153,7 @@ def full_rows(basis, nodes_list, quick):
                  "peak_MB": peak})  # fmt: skip
     print(_line(rows[-1]), flush=True)
     loads, pieces = stream(duration, n_contacts, nodes_list[-1])
-    wall, peak, _ = traced(
+    wall, peak, outputs = traced(
         lambda: sensor_outputs(basis, ZETA, loads, SENSORS, duration, quasi_static=False)
     )
     rows.append({"case": "full", "method": "sensor_outputs (whole chain)",
@@ -159,7 +161,7 @@ def full_rows(basis, nodes_list, quick):
                  "pieces": len(pieces), "load_nodes": loads.n_nodes,
                  "samples": times.size, "wall_s": wall, "peak_MB": peak})  # fmt: skip
     print(_line(rows[-1]), flush=True)
-    return rows
+    return rows, outputs
 
 
 def _line(row):
@@ -177,7 +179,8 @@ def main(out_dir, quick=False):
         rows = baseline_row(basis, 25, quick)
         for row in rows:
             print(_line(row), f"dense table {row['dense_table_MB']:.1f} MB", flush=True)
-        rows += full_rows(basis, [10, 25] if quick else [10, 25, 50, 100, 200], quick)
+        more, outputs = full_rows(basis, [10, 25] if quick else [10, 25, 50, 100, 200], quick)
+        rows += more
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     keys = list(dict.fromkeys(k for row in rows for k in row))
@@ -186,6 +189,8 @@ def main(out_dir, quick=False):
         writer.writeheader()
         writer.writerows(rows)
     (out / "table.md").write_text(_table(rows, basis))
+    positions = {s.name: s.position for s in SENSORS}
+    sensor_figures(outputs, out, positions)  # sensor_<name>.png: the stream's records
     print(_table(rows, basis))
 
 
