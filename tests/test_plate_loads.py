@@ -293,6 +293,11 @@ def test_bad_input_is_named(basis):
         plate_response(basis, 0.01, good, POINTS, times, max_bytes=1e3)
 
 
+def test_no_loads_leave_the_plate_at_rest(basis):
+    out = plate_response(basis, 0.01, PlateLoads(), POINTS, np.arange(100) * DT)
+    assert all(np.all(out[key] == 0.0) for key in "wva")
+
+
 def test_container_grows_and_keeps_pieces():
     loads = PlateLoads()
     for k in range(200):

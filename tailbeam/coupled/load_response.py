@@ -150,7 +150,7 @@ def node_jumps(loads, t0: float, dt: float, n_samples: int) -> dict:
     "target" sample (the first at or after it; 0 for nodes before t0; n_samples after the
     last); per piece its "last" node. (tailbeam.coupled.load_kernel.node_jumps)"""
     n = loads.n_nodes
-    last = np.append(loads.first[1:], n).astype(np.int64) - 1
+    last = np.append(loads.first[1:], n).astype(np.int64)[: len(loads)] - 1
     df, ds, target = np.empty(n), np.empty(n), np.empty(n, dtype=np.int64)
     jumps_kernel(loads.t, loads.force, loads.first, last, t0, dt, n_samples, df, ds, target)
     return {"df": df, "ds": ds, "target": target, "last": last}
