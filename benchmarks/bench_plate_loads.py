@@ -23,6 +23,9 @@ Rows:
 4. the full case through the whole sensor chain (sensor_outputs), wall time and peak memory;
    its records are drawn in DIR/sensor_s1.png, sensor_s2.png (tailbeam.sensor_figures).
 Rows 1-2 and 4 have the correction off.
+5. per-load-point costs with an FE Mindlin basis to 10 kHz (computed or cached by
+   compute_modes, ~3 s): mode shapes and quasi-static correction for 2 000 random point
+   loads and 1.5 mm discs (the Mindlin load model).
 Writes DIR/bench_plate_loads.csv and DIR/table.md. Run single-threaded (OMP_NUM_THREADS=1).
 """
 
@@ -164,6 +167,28 @@ def full_rows(basis, nodes_list, quick):
     return rows, outputs
 
 
+def fe_rows(quick):
+    """Per-load-point costs with an FE Mindlin basis (10 kHz; quick: 5 kHz): mode shapes and
+    the quasi-static correction for 2 000 random point loads and 1.5 mm Hertz discs."""
+    from tailbeam.coupled.load_response import _residual, load_shapes
+    from tailbeam.plate import compute_modes
+
+    basis = compute_modes(Plate(), "SSSS", theory="mindlin", fmax_hz=5000.0 if quick else FMAX)
+    rng = np.random.default_rng(2)
+    rows = []
+    seen = np.ones(2000, dtype=bool)
+    for radius in (0.0, 0.0015):
+        xyr = np.column_stack([rng.uniform(-0.28, 0.28, (2000, 2)), np.full(2000, radius)])
+        wall_shapes, _, phi = traced(lambda xyr=xyr: load_shapes(basis, xyr))
+        g = phi @ (basis.deflection(POINTS) / basis.omega**2).T
+        wall_res, _, _ = traced(lambda xyr=xyr, g=g: _residual(basis, xyr, POINTS, seen, g))
+        rows.append({"case": f"FE Mindlin {basis.n_modes} modes", "load radius (mm)": radius * 1e3,
+                     "load points": len(xyr), "shapes ms/point": wall_shapes / len(xyr) * 1e3,
+                     "quasi-static ms/point (2 sensors)": wall_res / len(xyr) * 1e3})  # fmt: skip
+        print(rows[-1], flush=True)
+    return rows
+
+
 def _line(row):
     return (f"{row['case']:8s} {row['method']:28s} nodes/contact {row['nodes_per_contact']:4d} "
             f"{row['duration_s']:5.2f} s {row['pieces']:6d} pieces {row['load_nodes']:8d} nodes "
@@ -181,6 +206,7 @@ def main(out_dir, quick=False):
             print(_line(row), f"dense table {row['dense_table_MB']:.1f} MB", flush=True)
         more, outputs = full_rows(basis, [10, 25] if quick else [10, 25, 50, 100, 200], quick)
         rows += more
+        fe = fe_rows(quick)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     keys = list(dict.fromkeys(k for row in rows for k in row))
@@ -188,10 +214,13 @@ def main(out_dir, quick=False):
         writer = csv.DictWriter(f, fieldnames=keys, restval="")
         writer.writeheader()
         writer.writerows(rows)
-    (out / "table.md").write_text(_table(rows, basis))
+    fe_lines = ["", "| " + " | ".join(fe[0]) + " |", "|---" * len(fe[0]) + "|"]
+    fe_lines += ["| " + " | ".join(f"{v:.3g}" if isinstance(v, float) else str(v)
+                                   for v in row.values()) + " |" for row in fe]  # fmt: skip
+    (out / "table.md").write_text(_table(rows, basis) + "\n".join(fe_lines) + "\n")
     positions = {s.name: s.position for s in SENSORS}
     sensor_figures(outputs, out, positions)  # sensor_<name>.png: the stream's records
-    print(_table(rows, basis))
+    print((out / "table.md").read_text())
 
 
 def _table(rows, basis):
