@@ -9,10 +9,10 @@ the node times. Optionally the truncated modes' quasi-static response is added a
 (as ``CoupledResult.quasi_static_sample``).
 
 Cost: O(samples x modes x points) for the march over the output grid, O(nodes x modes) for
-the load nodes (one damped-oscillator transition per node and mode), O(pieces) mode-shape
-evaluations. Memory: the three (points, samples) outputs, O(nodes) node tables, and the mode
-shapes of at most ``batch_nodes`` pieces at a time: never (modes x samples) or
-(nodes x pieces).
+the load nodes (a chained step per node and mode, one damped-oscillator transition per load
+and sample interval it has nodes in), O(pieces) mode-shape evaluations. Memory: the three
+(points, samples) outputs, O(nodes) node tables, and the mode shapes of at most
+``batch_nodes`` pieces at a time: never (modes x samples) or (nodes x pieces).
 """
 
 import math
@@ -90,15 +90,17 @@ def plate_response(
     omega = np.ascontiguousarray(basis.omega, dtype=float)
     zeta = _zeta(zeta, omega.shape[0])
     xyr = _load_points(basis, loads, load_radius)
+    if not (math.isfinite(node_time_ulps) and node_time_ulps >= 0):
+        raise InputError("node_time_ulps", f"must be >= 0, got {node_time_ulps!r}")
+    if not batch_nodes >= 1:
+        raise InputError("batch_nodes", f"must be >= 1, got {batch_nodes!r}")
     _check_memory(len(pts), n_samples, loads, omega.shape[0], batch_nodes, max_bytes)
     nodes = node_jumps(loads, t0, dt, n_samples)
     phi_pts = np.ascontiguousarray(basis.deflection(pts), dtype=float)
     out = empty_outputs(len(pts), n_samples)
     grid = (t0, dt, n_samples)
-    if not (math.isfinite(node_time_ulps) and node_time_ulps >= 0):
-        raise InputError("node_time_ulps", f"must be >= 0, got {node_time_ulps!r}")
-    chain = (batch_nodes, float(node_time_ulps))
-    g, h, seen = _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, grid, chain, out)
+    batching = (int(batch_nodes), float(node_time_ulps))
+    g, h, seen = _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, grid, batching, out)
     r = np.zeros_like(g)
     if quasi_static:
         r = _residual(basis, xyr, pts, seen, g)
@@ -148,7 +150,7 @@ def _load_points(basis, loads, load_radius) -> np.ndarray:
 def node_jumps(loads, t0: float, dt: float, n_samples: int) -> dict:
     """Per load node: the jump of the load's value "df" (N) and slope "ds" (N/s) there and its
     "target" sample (the first at or after it; 0 for nodes before t0; n_samples after the
-    last); per piece its "last" node. (tailbeam.coupled.load_kernel.node_jumps)"""
+    last); per piece its "last" node (tailbeam.coupled.load_kernel.jumps_kernel)."""
     n = loads.n_nodes
     last = np.append(loads.first[1:], n).astype(np.int64)[: len(loads)] - 1
     df, ds, target = np.empty(n), np.empty(n), np.empty(n, dtype=np.int64)
@@ -156,12 +158,13 @@ def node_jumps(loads, t0: float, dt: float, n_samples: int) -> dict:
     return {"df": df, "ds": ds, "target": target, "last": last}
 
 
-def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, chain, out):
+def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, out):
     """Run ``march`` over all samples, the nodes in batches of ``batch_nodes`` (their pieces'
-    mode shapes evaluated per batch). Returns G, H (pieces, p) and which pieces were seen."""
+    mode shapes evaluated per batch); times = (t0 s, dt s, N), batching = (batch_nodes,
+    node_time_ulps). Returns G, H (pieces, p) and which pieces were seen."""
     n_pieces = xyr.shape[0]
     t0, dt, n_samples = times
-    batch_nodes, ulps = chain
+    batch_nodes, ulps = batching
     t_nodes, first = loads.t, loads.first
     g = np.zeros((n_pieces, phi_pts.shape[0]))
     h = np.zeros_like(g)
