@@ -1,0 +1,184 @@
+"""Compiled (numba) twin of ``step_events``: certified first crossings inside one step.
+
+A watched function g of one DOP853 step (a polynomial of degree <= 14 in the step fraction s:
+a squared distance, a plate gap, an edge distance) is given by its values at the 15
+Chebyshev points ``STEP_POINTS`` of the step. Its Chebyshev coefficients c (``VINV`` @ values)
+satisfy |g - c0| <= sum_k>=1 |c_k| on the interval, so c0 > sum |c_k| certifies g > 0 there.
+A row that is not certified is searched for its FIRST downward crossing by subdivision:
+
+* the first node value <= 0 (index j) brackets a crossing in [s_(j-1), s_j]; the part left of
+  it, [a, s_(j-1)], is searched first (re-interpolated at its own 15 points and certified or
+  subdivided), so a dip between earlier nodes is not passed over;
+* an interval with no node <= 0 that is not certified is halved (left half first) down to a
+  width of ``MIN_WIDTH`` of the step (a graze shallower than that is below the dead bands);
+* a bracket is closed by the Illinois method on the interpolant (Clenshaw), to 4 ulp of s.
+
+Same result as ``step_events.first_downward_crossing`` (numpy's ``chebroots``), without
+eigenvalues; tested against it in tests/test_active_set.py.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from tailbeam.solvers.step_events import _VINV, NODES, STEP_POINTS
+
+VINV = np.ascontiguousarray(_VINV)
+FRESH_S = 1e-10  # as step_events.FRESH_S: roots this close to a restart are the restart's
+MIN_WIDTH = 1e-13  # smallest interval (fraction of the step) the subdivision examines
+_STACK = 256
+
+
+@njit(cache=True)
+def clenshaw(c, u):
+    """Chebyshev series c at u in [-1, 1]."""
+    b1 = 0.0
+    b2 = 0.0
+    for k in range(c.shape[0] - 1, 0, -1):
+        b1, b2 = 2.0 * u * b1 - b2 + c[k], b1
+    return u * b1 - b2 + c[0]
+
+
+@njit(cache=True)
+def cheb_coefficients(values, vinv, out):
+    """out = vinv @ values: Chebyshev coefficients of the interpolant through ``values``."""
+    n = values.shape[0]
+    for i in range(n):
+        acc = 0.0
+        for j in range(n):
+            acc += vinv[i, j] * values[j]
+        out[i] = acc
+
+
+@njit(cache=True)
+def certified(c):
+    """Whether the series c is > 0 on its whole interval (c0 > sum |c_k|, with margin)."""
+    s = 0.0
+    for k in range(1, c.shape[0]):
+        s += abs(c[k])
+    return c[0] > s * (1.0 + 1e-12)
+
+
+@njit(cache=True)
+def _g(c, s):
+    return clenshaw(c, 2.0 * s - 1.0)
+
+
+@njit(cache=True)
+def illinois(c, lo, glo, hi, ghi):
+    """Root of the series c (in s) in [lo, hi] with g(lo) > 0 >= g(hi); to 4 ulp of s."""
+    side = 0
+    for _ in range(200):
+        if hi - lo <= 4.0 * 2.220446049250313e-16 * max(1.0, abs(hi)):
+            break
+        sm = (lo * ghi - hi * glo) / (ghi - glo)
+        if not (lo < sm < hi):
+            sm = 0.5 * (lo + hi)
+        gm = _g(c, sm)
+        if gm > 0.0:
+            lo, glo = sm, gm
+            if side == -1:
+                ghi *= 0.5
+            side = -1
+        else:
+            hi, ghi = sm, gm
+            if side == 1:
+                glo *= 0.5
+            side = 1
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
+def first_crossing(c, values, fresh, pts, vinv, wv, wc, stack):
+    """First fraction s in [0, 1] where the series c (values at ``pts``) becomes <= 0; inf
+    if none. ``fresh``: g sat on zero at s = 0 (its own event's restart): the search starts at
+    ``FRESH_S``. wv, wc (15,) and stack (256, 3) are scratch."""
+    a = 0.0
+    if fresh:
+        a = FRESH_S
+        if _g(c, a) <= 0.0:
+            return math.inf
+    elif values[0] < 0.0:
+        return 0.0
+    top = 0
+    stack[0, 0], stack[0, 1], stack[0, 2] = a, 1.0, 0.0
+    top = 1
+    n = pts.shape[0]
+    while top > 0:
+        top -= 1
+        lo, hi, kind = stack[top, 0], stack[top, 1], stack[top, 2]
+        if kind == 1.0:
+            return illinois(c, lo, _g(c, lo), hi, _g(c, hi))
+        for q in range(n):
+            wv[q] = _g(c, lo + (hi - lo) * pts[q])
+        if wv[0] <= 0.0:
+            return lo
+        cheb_coefficients(wv, vinv, wc)
+        if certified(wc):
+            continue
+        j = -1
+        for q in range(1, n):
+            if wv[q] <= 0.0:
+                j = q
+                break
+        if top + 2 > stack.shape[0]:
+            return math.inf  # (cannot happen: depth <= log2(1 / MIN_WIDTH))
+        if j < 0:
+            if hi - lo < MIN_WIDTH:
+                continue
+            mid = 0.5 * (lo + hi)
+            stack[top, 0], stack[top, 1], stack[top, 2] = mid, hi, 0.0
+            stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2] = lo, mid, 0.0
+            top += 2
+            continue
+        sl = lo + (hi - lo) * pts[j - 1]
+        sr = lo + (hi - lo) * pts[j]
+        if j == 1:
+            return illinois(c, sl, wv[0], sr, wv[1])
+        stack[top, 0], stack[top, 1], stack[top, 2] = sl, sr, 1.0
+        stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2] = lo, sl, 0.0
+        top += 2
+    return math.inf
+
+
+@njit(cache=True)
+def interpolant_max(values, vinv, wc, wd):
+    """(s, value) of the maximum of the Chebyshev interpolant through ``values`` at
+    ``STEP_POINTS``: the largest node, refined at the root of the derivative in the node
+    intervals next to it (as ``step_events.interpolant_max``). wc, wd (15,) scratch."""
+    n = values.shape[0]
+    k = 0
+    for q in range(1, n):
+        if values[q] > values[k]:
+            k = q
+    cheb_coefficients(values, vinv, wc)
+    # derivative series (numpy's chebder) into wd[0 : n - 1]
+    for q in range(n):
+        wd[q] = 0.0
+    for j in range(n - 1, 0, -1):
+        wd[j - 1] = 2.0 * j * wc[j] + (wd[j + 1] if j + 1 < n - 1 else 0.0)
+    wd[0] *= 0.5
+    best_s = 0.5 * (1.0 - math.cos(math.pi * k / (n - 1)))
+    best = values[k]
+    for side in range(2):
+        qa = k - 1 + side
+        qb = qa + 1
+        if qa < 0 or qb > n - 1:
+            continue
+        sa = 0.5 * (1.0 - math.cos(math.pi * qa / (n - 1)))
+        sb = 0.5 * (1.0 - math.cos(math.pi * qb / (n - 1)))
+        da = clenshaw(wd[: n - 1], 2.0 * sa - 1.0)
+        db = clenshaw(wd[: n - 1], 2.0 * sb - 1.0)
+        if da > 0.0 and db <= 0.0:
+            s = illinois(wd[: n - 1], sa, da, sb, db)
+            value = clenshaw(wc, 2.0 * s - 1.0)
+            if value > best:
+                best_s, best = s, value
+    return best_s, best
+
+
+def tables():
+    """(pts, vinv): the 15 step fractions and the inverse Chebyshev-Vandermonde matrix."""
+    assert NODES == 15
+    return np.ascontiguousarray(STEP_POINTS), VINV
