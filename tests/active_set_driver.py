@@ -25,8 +25,9 @@ def reference_pairs(n):
 
 
 class SceneRun:
-    """Runs ``balls`` on ``incline`` for ``duration`` s; ``contacts``, ``leaves``, ``times``
-    and ``energy`` (J, at every return of ``advance`` and every ``sample`` s)."""
+    """Runs ``balls`` on ``incline`` for ``duration`` s; ``contacts``, ``leaves``, ``times``,
+    ``energy`` (J) and ``states`` (x, v, touching) at every return of ``advance`` (events and
+    every ``sample`` s)."""
 
     def __init__(self, balls, incline, duration, *, sample=None, settle_energy=None, **kwargs):
         self.balls, self.incline = balls, incline
@@ -38,7 +39,7 @@ class SceneRun:
         )
         self.contacts, self.leaves, self.settled = [], [], []
         self.open = {}
-        self.times, self.energy, self.returns = [], [], []
+        self.times, self.energy, self.returns, self.states = [], [], [], []
         for p in np.flatnonzero(self.set.touching):
             self.start(int(p), 0.0)
         self.run(duration, sample or duration)
@@ -87,6 +88,7 @@ class SceneRun:
             e += k * max(delta, 0.0) ** (ex + 1.0) / (ex + 1.0)
         self.times.append(t)
         self.energy.append(e)
+        self.states.append((s.x.copy(), s.v.copy(), s.touching.copy()))
 
     def run(self, duration, sample):
         t = 0.0

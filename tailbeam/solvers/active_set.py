@@ -36,7 +36,7 @@ from tailbeam.solvers import active_kernel as ak
 from tailbeam.solvers.active_pairs import pair_state
 from tailbeam.solvers.cheb_events import tables as cheb_tables
 
-DEFAULT_NODES = 8  # interior force rows per step (see NOTES: linear interpolation ~1e-5)
+DEFAULT_NODES = 40  # interior force rows per step: linear interpolation < 1e-5 of the peak
 
 
 @dataclass(frozen=True)
