@@ -156,7 +156,7 @@ def test_compiled_first_crossing_equals_step_events():
     chebroots) on random degree-14 polynomials, including dips between the nodes (1e-12)."""
     pts, vinv = cheb_events.tables()
     rng = np.random.default_rng(3)
-    wv, wc, stack = np.zeros(15), np.zeros(15), np.zeros((256, 3))
+    wv, wc, wd, stack = np.zeros(15), np.zeros(15), np.zeros(15), np.zeros((256, 3))
     found = 0
     for _ in range(300):
         roots = np.sort(rng.uniform(-0.2, 1.2, 2))
@@ -169,7 +169,7 @@ def test_compiled_first_crossing_equals_step_events():
         values = cheb.chebval(2.0 * pts - 1.0, c_poly)
         c = step_events.chebyshev_coefficients(values)
         want = step_events.first_downward_crossing(c, values, False)
-        got = cheb_events.first_crossing(c, values, False, pts, vinv, wv, wc, stack)
+        got = cheb_events.first_crossing(c, values, False, pts, vinv, wv, wc, wd, stack)
         if math.isinf(want):
             assert math.isinf(got)
         else:

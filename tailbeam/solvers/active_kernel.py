@@ -22,6 +22,7 @@ from numba import njit
 from tailbeam.solvers.active_pairs import (
     L_C,
     L_CLAMP,
+    L_D,
     R_CLAMP,
     R_CONTACT,
     R_EDGE,
@@ -30,8 +31,10 @@ from tailbeam.solvers.active_pairs import (
     pair_force,
     pair_state,
     rhs,
+    rhs_arrays,
     row_band,
     row_value,
+    row_value_arrays,
     settle_excess,
 )
 from tailbeam.solvers.cheb_events import (
@@ -40,6 +43,7 @@ from tailbeam.solvers.cheb_events import (
     first_crossing,
     interpolant_max,
 )
+from tailbeam.solvers.jit import helper_njit
 
 # return status of ``advance``
 ST_STOP, ST_START, ST_END, ST_LEAVE, ST_SETTLE, ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = range(8)
@@ -59,9 +63,11 @@ EPS = 2.220446049250313e-16
 MAX_FRESH = 16
 
 
-@njit(cache=True)
+@helper_njit
 def _stages(K, A, first, stop, y, h, model, pstate, tmp):
     """Runge-Kutta stages first..stop-1 into K (rows: stages)."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
     n = y.shape[0]
     for s in range(first, stop):
         for q in range(n):
@@ -69,10 +75,10 @@ def _stages(K, A, first, stop, y, h, model, pstate, tmp):
             for j in range(s):
                 acc += A[s, j] * K[j, q]
             tmp[q] = y[q] + h * acc
-        rhs(tmp, model, pstate, K[s])
+        rhs_arrays(tmp, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, K[s])
 
 
-@njit(cache=True)
+@helper_njit
 def _step(y, h, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp):
     """One DOP853 step of size h from y (K[0] = f(y) given): ynew, K[12] = f(ynew); returns
     scipy's error norm (NaN or > 1: reject)."""
@@ -102,7 +108,7 @@ def _step(y, h, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp):
     return h * err5 / math.sqrt((err5 + 0.01 * err3) * n)
 
 
-@njit(cache=True)
+@helper_njit
 def _dense_coef(y, ynew, h, K, tab, model, pstate, coef, tmp):
     """The 3 extra stages and the 7 rows of DOP853's dense output (scipy's F)."""
     A, D = tab[0], tab[4]
@@ -119,7 +125,7 @@ def _dense_coef(y, ynew, h, K, tab, model, pstate, coef, tmp):
             coef[3 + i, q] = h * acc
 
 
-@njit(cache=True)
+@helper_njit
 def _dense1(coef, y, s, q):
     """Component q of the dense output at fraction s of the step."""
     a = 0.0
@@ -129,13 +135,13 @@ def _dense1(coef, y, s, q):
     return y[q] + a
 
 
-@njit(cache=True)
+@helper_njit
 def _dense(coef, y, s, out):
     for q in range(y.shape[0]):
         out[q] = _dense1(coef, y, s, q)
 
 
-@njit(cache=True)
+@helper_njit
 def _is_fresh(kind, idx, fresh, nfresh):
     for f in range(nfresh):
         if fresh[f, 0] == kind and fresh[f, 1] == idx:
@@ -143,7 +149,7 @@ def _is_fresh(kind, idx, fresh, nfresh):
     return False
 
 
-@njit(cache=True)
+@helper_njit
 def _sampled_crossing(kind, idx, vals, fresh, y, coef, pts, model, pstate, tmp):
     """First s where a sampled (non-polynomial) row leaves its side: a node on the wrong side
     right after one on the right side, closed by Illinois on the dense output. A fresh row
@@ -176,25 +182,100 @@ def _sampled_crossing(kind, idx, vals, fresh, y, coef, pts, model, pstate, tmp):
     return math.inf
 
 
-@njit(cache=True)
-def _row_first(kind, idx, Y15, y, coef, fr, pts, vinv, model, pstate, ws):
-    """First crossing (fraction of the step, inf if none) of one row."""
-    vals, wc, wv, wc2, stack, tmp = ws
+@helper_njit
+def _prepare(dense):
+    """Start of a step's event work: no ball evaluated at the Chebyshev points yet, and the
+    bound B[q] = sum_i |coef[i, q]| >= |y_q(s) - y_q(0)| on the whole step (every factor of
+    the dense output's nested form lies in [0, 1])."""
+    Y15, have, coef, y, B = dense
+    for b in range(have.shape[0]):
+        have[b] = False
+    for q in range(y.shape[0]):
+        acc = 0.0
+        for i in range(7):
+            acc += abs(coef[i, q])
+        B[q] = acc
+
+
+@helper_njit
+def _ensure(Y15, have, coef, y, pts, b):
+    """Ball b's 6 state components at the 15 Chebyshev points of the step (once per step)."""
+    if b < 0 or have[b]:
+        return
+    have[b] = True
+    n = have.shape[0]
     for q in range(pts.shape[0]):
-        vals[q] = row_value(kind, idx, Y15[q], model, pstate)
+        for k in range(3):
+            Y15[q, 3 * b + k] = _dense1(coef, y, pts[q], 3 * b + k)
+            Y15[q, 3 * n + 3 * b + k] = _dense1(coef, y, pts[q], 3 * n + 3 * b + k)
+
+
+@helper_njit
+def _reach(B, b):
+    """Bound in m on how far ball b's centre moves from its start during the step."""
+    return math.sqrt(B[3 * b] ** 2 + B[3 * b + 1] ** 2 + B[3 * b + 2] ** 2)
+
+
+@helper_njit
+def _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp):
+    """Whether row (kind, idx) is certified positive on the step by the bound B alone:
+    edges and centre distances move at most B from their start values (no 15-point
+    evaluation needed: far-apart pairs and balls far from the edges cost O(1))."""
+    if kind == R_CLAMP:
+        return False
+    if kind == R_EDGE:
+        b, e = idx // 4, idx % 4
+        c = y[3 * b + e // 2]
+        f = c + half[e // 2] if e % 2 == 0 else half[e // 2] - c
+        return f + 1e-13 - B[3 * b + e // 2] > 0.0  # (EDGE_BAND)
+    i, j, rs = pi[idx], pj[idx], rsum[idx]
+    if j < 0:
+        dist0, reach = y[3 * i + 2], B[3 * i + 2]
+    else:
+        dist0 = rs - pair_state(y, n, i, j, rs)[0]
+        reach = _reach(B, i) + _reach(B, j)
+    lo, hi = dist0 - reach, dist0 + reach  # the distance stays within [lo, hi]
+    margin = 1e-12 * rs
+    if kind == R_CONTACT:
+        return hi < rs - margin and lo > 0.0 if touching[idx] else lo > rs + margin
+    r_full = rs - law[idx, L_D]
+    return lo > r_full + margin if ramp[idx] else (hi < r_full - margin and lo > 0.0)
+
+
+@helper_njit
+def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, pj, law,
+                  rsum, touching, ramp, clamped, vals, wc, wv, wc2, wd, stack, tmp, model,
+                  pstate):  # fmt: skip
+    """First crossing (fraction of the step, inf if none) of row (kind, idx): the bound B,
+    else the 15-point certificate, else the search (``cheb_events``)."""
+    if _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp):
+        return math.inf
+    if kind == R_EDGE:
+        _ensure(Y15, have, coef, y, pts, idx // 4)
+    else:
+        _ensure(Y15, have, coef, y, pts, pi[idx])
+        _ensure(Y15, have, coef, y, pts, pj[idx])
+    for q in range(pts.shape[0]):
+        vals[q] = row_value_arrays(
+            kind, idx, Y15[q], n, half, pi, pj, law, rsum, touching, ramp, clamped
+        )
     if kind == R_CLAMP:
         return _sampled_crossing(kind, idx, vals, fr, y, coef, pts, model, pstate, tmp)
     cheb_coefficients(vals, vinv, wc)
     if certified(wc):
         return math.inf
-    return first_crossing(wc, vals, fr, pts, vinv, wv, wc2, stack)
+    return first_crossing(wc, vals, fr, pts, vinv, wv, wc2, wd, stack)
 
 
-@njit(cache=True)
-def _detect(Y15, y, coef, fresh, nfresh, pts, vinv, model, pstate, ws):
-    """Earliest (s, kind, idx) of a row crossing in the step; kind -1 if none."""
+@helper_njit
+def _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
+    """Earliest (s, kind, idx) of a row crossing in the step; kind -1 if none. (The tuples
+    are unpacked once here: the helpers take arrays, see ``rhs_arrays``.)"""
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
-    touching = pstate[0]
+    touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
+    Y15, have, coef, y, B = dense
+    vals, wc, wv, wc2, wd, stack, tmp = ws
+    n = mass.shape[0]
     best_s, best_k, best_i = math.inf, -1, -1
     for p in range(pi.shape[0]):
         if not alive[pi[p]] or (pj[p] >= 0 and not alive[pj[p]]):
@@ -205,20 +286,24 @@ def _detect(Y15, y, coef, fresh, nfresh, pts, vinv, model, pstate, ws):
             if kind == R_CLAMP and law[p, L_CLAMP] <= 0.0:
                 break
             fr = _is_fresh(kind, p, fresh, nfresh)
-            s = _row_first(kind, p, Y15, y, coef, fr, pts, vinv, model, pstate, ws)
+            s = _row_crossing(kind, p, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, pj,
+                              law, rsum, touching, ramp, clamped, vals, wc, wv, wc2, wd, stack,
+                              tmp, model, pstate)  # fmt: skip
             if s < best_s:
                 best_s, best_k, best_i = s, kind, p
-    for b in range(mass.shape[0]):
+    for b in range(n):
         if not alive[b]:
             continue
         for e in range(4):
-            s = _row_first(R_EDGE, 4 * b + e, Y15, y, coef, False, pts, vinv, model, pstate, ws)
+            s = _row_crossing(R_EDGE, 4 * b + e, False, Y15, have, coef, y, B, pts, vinv, n,
+                              half, pi, pj, law, rsum, touching, ramp, clamped, vals, wc, wv,
+                              wc2, wd, stack, tmp, model, pstate)  # fmt: skip
             if s < best_s:
                 best_s, best_k, best_i = s, R_EDGE, 4 * b + e
     return best_s, best_k, best_i
 
 
-@njit(cache=True)
+@helper_njit
 def _write_row(rows, iout, t, p, f):
     r = iout[IO_ROWS]
     rows[r, 0] = t
@@ -227,18 +312,21 @@ def _write_row(rows, iout, t, p, f):
     iout[IO_ROWS] = r + 1
 
 
-@njit(cache=True)
-def _accept(t, h, y, ynew, coef, Y15, nodes, pts, vinv, model, pstate, rows, iout, ws):
+@helper_njit
+def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
     """Peak force / max penetration of the touching pairs on the accepted step (maximum of
     their Chebyshev interpolant, refined where the nodes come within 1 % of the record), and
     the plate force rows at ``nodes`` interior points and the step end."""
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
     touching, ramp, clamped, peak, t_peak, pen = pstate
-    vals, wc, wv, wc2, stack, tmp = ws
+    vals, wc, wv, wc2, wd, stack, tmp = ws
+    Y15, have, coef, y, B = dense
     n = mass.shape[0]
     for p in range(pi.shape[0]):
         if not touching[p]:
             continue
+        _ensure(Y15, have, coef, y, pts, pi[p])
+        _ensure(Y15, have, coef, y, pts, pj[p])
         fmax = -math.inf
         for q in range(pts.shape[0]):
             f, delta, _, _, _ = pair_force(Y15[q], n, p, pi, pj, law, rsum, ramp, clamped)
@@ -269,7 +357,7 @@ def _accept(t, h, y, ynew, coef, Y15, nodes, pts, vinv, model, pstate, rows, iou
         _write_row(rows, iout, t + h, p, f)
 
 
-@njit(cache=True)
+@helper_njit
 def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
     """Apply the event of row (kind, idx) at time t, state y; returns the status to return
     with (ST_START, ST_END, ST_LEAVE) or -1 for a kink handled here (logged)."""
@@ -309,7 +397,7 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
     return -1
 
 
-@njit(cache=True)
+@helper_njit
 def _settle(y, model, pstate, count, plate_pair):
     """First ball whose only touching pair is the plate and whose excess energy
     (``settle_excess``) is below its settle energy; -1 if none. Checked at step ends."""
@@ -333,7 +421,7 @@ def _settle(y, model, pstate, count, plate_pair):
     return -1
 
 
-@njit(cache=True)
+@helper_njit
 def _rows_needed(model, pstate, nodes):
     """Force rows one more step (and its events) may write: (nodes + 1) per touching plate
     pair, plus a start and an end row."""
@@ -363,10 +451,11 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
     tmp = np.zeros(nst)
     coef = np.zeros((7, nst))
     npts = pts.shape[0]
-    Y15 = np.zeros((npts, nst))
-    ws = (np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts),
-          np.zeros((256, 3)), np.zeros(nst))  # fmt: skip
     nb = model[0].shape[0]
+    dense = (np.zeros((npts, nst)), np.zeros(nb, dtype=np.bool_), coef, np.zeros(nst),
+             np.zeros(nst))  # fmt: skip
+    ws = (np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts),
+          np.zeros((256, 3)), np.zeros(nst))  # fmt: skip
     count = np.zeros(nb, dtype=np.int64)
     plate_pair = np.zeros(nb, dtype=np.int64)
     fresh = np.zeros((MAX_FRESH, 2), dtype=np.int64)
@@ -426,9 +515,9 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
             continue
         _dense_coef(y, ynew, hh, K, tab, model, pstate, coef, tmp)
         iout[IO_NFEV] += 3
-        for q in range(npts):
-            _dense(coef, y, pts[q], Y15[q])
-        s, k, i = _detect(Y15, y, coef, fresh, nfresh, pts, vinv, model, pstate, ws)
+        dense[3][:] = y
+        _prepare(dense)
+        s, k, i = _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws)
         if k >= 0 and pend_k >= 0 and t + s * hh >= pend_t - SAME_TIME * hh:
             k = -1  # (about) simultaneous with the pending event: taken after it
         factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** (-1.0 / 8.0))
@@ -436,7 +525,7 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
             factor = min(1.0, factor)
         rejected = False
         if k < 0:
-            _accept(t, hh, y, ynew, coef, Y15, nodes, pts, vinv, model, pstate, rows, iout, ws)
+            _accept(t, hh, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws)
             t = t_bound if last else t + hh
             y[:] = ynew
             f0[:] = K[12]

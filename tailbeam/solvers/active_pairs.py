@@ -29,7 +29,7 @@ grazing touch does not start and end contacts over and over at round-off level.
 
 import math
 
-from numba import njit
+from tailbeam.solvers.jit import helper_njit
 
 L_K, L_E, L_C, L_D, L_CLAMP = range(5)
 R_CONTACT, R_FULL, R_CLAMP, R_EDGE = range(4)
@@ -37,7 +37,7 @@ CLAMP_BAND = 1e-10
 EDGE_BAND = 1e-13
 
 
-@njit(cache=True)
+@helper_njit
 def _pow(x, e):
     """x^e for x >= 0; the Hertz exponent 3/2 as x sqrt(x)."""
     if e == 1.5:
@@ -45,7 +45,7 @@ def _pow(x, e):
     return x**e
 
 
-@njit(cache=True)
+@helper_njit
 def damping_in_region(delta, c, d, ramp):
     """c STEP(delta, 0, 0, d, c) extended past [0, d] (ramp) or c (full damping), N s/m."""
     if not ramp:
@@ -54,7 +54,7 @@ def damping_in_region(delta, c, d, ramp):
     return c * s * s * (3.0 - 2.0 * s)
 
 
-@njit(cache=True)
+@helper_njit
 def region_force(delta, rate, k, e, c, d, ramp, clamped):
     """Force in N of one region's smooth formula (twin of impact_force_in_region)."""
     if clamped:
@@ -63,7 +63,7 @@ def region_force(delta, rate, k, e, c, d, ramp, clamped):
     return k * _pow(pos, e) + damping_in_region(pos, c, d, ramp) * rate
 
 
-@njit(cache=True)
+@helper_njit
 def clamp_indicator(delta, rate, k, e, c, d, ramp):
     """Raw force / (k delta^e) (twin of contact_law.clamp_indicator)."""
     if delta > 0.0:
@@ -75,7 +75,7 @@ def clamp_indicator(delta, rate, k, e, c, d, ramp):
     return -1.0 if rate < 0.0 else 1.0
 
 
-@njit(cache=True)
+@helper_njit
 def elastic_energy(delta, k, e):
     """k delta^(e+1) / (e+1) in J for delta > 0, else 0."""
     if delta <= 0.0:
@@ -83,7 +83,7 @@ def elastic_energy(delta, k, e):
     return k * _pow(delta, e) * delta / (e + 1.0)
 
 
-@njit(cache=True)
+@helper_njit
 def pair_state(y, n, i, j, rsum):
     """(delta, rate, nx, ny, nz) of the pair (i, j) at state y (j < 0: the plate)."""
     xi = 3 * i
@@ -101,7 +101,7 @@ def pair_state(y, n, i, j, rsum):
     return rsum - dist, -wn, nx, ny, nz
 
 
-@njit(cache=True)
+@helper_njit
 def pair_force(y, n, p, pi, pj, law, rsum, ramp, clamped):
     """(F, delta, nx, ny, nz) of pair p in its region at state y."""
     delta, rate, nx, ny, nz = pair_state(y, n, pi[p], pj[p], rsum[p])
@@ -111,11 +111,11 @@ def pair_force(y, n, p, pi, pj, law, rsum, ramp, clamped):
     return f, delta, nx, ny, nz
 
 
-@njit(cache=True)
-def rhs(y, model, pstate, out):
-    """dy/dt of the active set: gravity on every present ball plus the touching pairs."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
-    touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
+@helper_njit
+def rhs_arrays(y, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, out):
+    """dy/dt of the active set: gravity on every present ball plus the touching pairs.
+    (Arrays passed one by one: unpacking the model tuple on every call costs more than the
+    right-hand side of a small set.)"""
     n = mass.shape[0]
     for b in range(n):
         for k in range(3):
@@ -139,7 +139,14 @@ def rhs(y, model, pstate, out):
             out[3 * n + 3 * j + 2] -= a * nz
 
 
-@njit(cache=True)
+@helper_njit
+def rhs(y, model, pstate, out):
+    """``rhs_arrays`` with the model and pair-state tuples."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    rhs_arrays(y, mass, g, pi, pj, law, rsum, pstate[0], pstate[1], pstate[2], alive, out)
+
+
+@helper_njit
 def row_band(kind, idx, rsum):
     """Dead band of a row (see the module docstring)."""
     if kind == R_EDGE:
@@ -149,12 +156,9 @@ def row_band(kind, idx, rsum):
     return 1e-12 * rsum[idx] * rsum[idx]
 
 
-@njit(cache=True)
-def row_value(kind, idx, y, model, pstate):
+@helper_njit
+def row_value_arrays(kind, idx, y, n, half, pi, pj, law, rsum, touching, ramp, clamped):
     """g = sign x f + band of row (kind, idx) at state y: > 0 on the row's side."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
-    touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
-    n = mass.shape[0]
     if kind == R_EDGE:
         b, e = idx // 4, idx % 4
         c = y[3 * b + e // 2]
@@ -184,7 +188,16 @@ def row_value(kind, idx, y, model, pstate):
     return (f if ramp[idx] else -f) + band
 
 
-@njit(cache=True)
+@helper_njit
+def row_value(kind, idx, y, model, pstate):
+    """``row_value_arrays`` with the model and pair-state tuples."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
+    n = mass.shape[0]
+    return row_value_arrays(kind, idx, y, n, half, pi, pj, law, rsum, touching, ramp, clamped)
+
+
+@helper_njit
 def first_contact_step(y, model, p, rtol):
     """First step after a contact start (s): where the tau^(e+2) term of the penetration
     reaches rtol, t_s rtol^(1/(e+2)), and within half the ramp (as tailbeam.rigid)."""
@@ -199,7 +212,7 @@ def first_contact_step(y, model, p, rtol):
     return min(delta_m / speed * rtol ** (1.0 / (e + 2.0)), 0.5 * law[p, L_D] / speed)
 
 
-@njit(cache=True)
+@helper_njit
 def settle_excess(y, model, p, b):
     """Normal excess energy (J) of ball b on the plate pair p over its static state:
     1/2 m vz^2 + U(delta) - U(delta_s) - m g_n (delta - delta_s), delta_s = (m g_n / k)^(1/e)."""

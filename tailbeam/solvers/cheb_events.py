@@ -9,8 +9,11 @@ A row that is not certified is searched for its FIRST downward crossing by subdi
 * the first node value <= 0 (index j) brackets a crossing in [s_(j-1), s_j]; the part left of
   it, [a, s_(j-1)], is searched first (re-interpolated at its own 15 points and certified or
   subdivided), so a dip between earlier nodes is not passed over;
-* an interval with no node <= 0 that is not certified is halved (left half first) down to a
-  width of ``MIN_WIDTH`` of the step (a graze shallower than that is below the dead bands);
+* an interval with no node <= 0 that is not certified is skipped if its derivative is
+  certified of one sign (monotone: both ends > 0, so positive throughout: the common case of
+  a row that starts near 0 right after its event and moves away), else halved (left half
+  first) down to a width of ``MIN_WIDTH`` of the step (a graze shallower than that is below
+  the dead bands);
 * a bracket is closed by the Illinois method on the interpolant (Clenshaw), to 4 ulp of s.
 
 Same result as ``step_events.first_downward_crossing`` (numpy's ``chebroots``), without
@@ -20,8 +23,8 @@ eigenvalues; tested against it in tests/test_active_set.py.
 import math
 
 import numpy as np
-from numba import njit
 
+from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.step_events import _VINV, NODES, STEP_POINTS
 
 VINV = np.ascontiguousarray(_VINV)
@@ -30,7 +33,7 @@ MIN_WIDTH = 1e-13  # smallest interval (fraction of the step) the subdivision ex
 _STACK = 256
 
 
-@njit(cache=True)
+@helper_njit
 def clenshaw(c, u):
     """Chebyshev series c at u in [-1, 1]."""
     b1 = 0.0
@@ -40,7 +43,7 @@ def clenshaw(c, u):
     return u * b1 - b2 + c[0]
 
 
-@njit(cache=True)
+@helper_njit
 def cheb_coefficients(values, vinv, out):
     """out = vinv @ values: Chebyshev coefficients of the interpolant through ``values``."""
     n = values.shape[0]
@@ -51,7 +54,7 @@ def cheb_coefficients(values, vinv, out):
         out[i] = acc
 
 
-@njit(cache=True)
+@helper_njit
 def certified(c):
     """Whether the series c is > 0 on its whole interval (c0 > sum |c_k|, with margin)."""
     s = 0.0
@@ -60,12 +63,33 @@ def certified(c):
     return c[0] > s * (1.0 + 1e-12)
 
 
-@njit(cache=True)
+@helper_njit
+def derivative(c, out):
+    """Chebyshev series of dc/du into out[: n - 1] (numpy's chebder); out[n - 1] = 0."""
+    n = c.shape[0]
+    for q in range(n):
+        out[q] = 0.0
+    for j in range(n - 1, 0, -1):
+        out[j - 1] = 2.0 * j * c[j] + (out[j + 1] if j + 1 < n - 1 else 0.0)
+    out[0] *= 0.5
+
+
+@helper_njit
+def monotone(c, wd):
+    """Whether the derivative of series c is certified of one sign (c monotone)."""
+    derivative(c, wd)
+    s = 0.0
+    for k in range(1, wd.shape[0]):
+        s += abs(wd[k])
+    return abs(wd[0]) > s * (1.0 + 1e-12)
+
+
+@helper_njit
 def _g(c, s):
     return clenshaw(c, 2.0 * s - 1.0)
 
 
-@njit(cache=True)
+@helper_njit
 def illinois(c, lo, glo, hi, ghi):
     """Root of the series c (in s) in [lo, hi] with g(lo) > 0 >= g(hi); to 4 ulp of s."""
     side = 0
@@ -89,11 +113,11 @@ def illinois(c, lo, glo, hi, ghi):
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True)
-def first_crossing(c, values, fresh, pts, vinv, wv, wc, stack):
+@helper_njit
+def first_crossing(c, values, fresh, pts, vinv, wv, wc, wd, stack):
     """First fraction s in [0, 1] where the series c (values at ``pts``) becomes <= 0; inf
     if none. ``fresh``: g sat on zero at s = 0 (its own event's restart): the search starts at
-    ``FRESH_S``. wv, wc (15,) and stack (256, 3) are scratch."""
+    ``FRESH_S``. wv, wc, wd (15,) and stack (256, 3) are scratch."""
     a = 0.0
     if fresh:
         a = FRESH_S
@@ -125,8 +149,8 @@ def first_crossing(c, values, fresh, pts, vinv, wv, wc, stack):
         if top + 2 > stack.shape[0]:
             return math.inf  # (cannot happen: depth <= log2(1 / MIN_WIDTH))
         if j < 0:
-            if hi - lo < MIN_WIDTH:
-                continue
+            if hi - lo < MIN_WIDTH or monotone(wc, wd):
+                continue  # (monotone with both ends > 0: positive throughout)
             mid = 0.5 * (lo + hi)
             stack[top, 0], stack[top, 1], stack[top, 2] = mid, hi, 0.0
             stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2] = lo, mid, 0.0
@@ -142,7 +166,7 @@ def first_crossing(c, values, fresh, pts, vinv, wv, wc, stack):
     return math.inf
 
 
-@njit(cache=True)
+@helper_njit
 def interpolant_max(values, vinv, wc, wd):
     """(s, value) of the maximum of the Chebyshev interpolant through ``values`` at
     ``STEP_POINTS``: the largest node, refined at the root of the derivative in the node
@@ -153,12 +177,7 @@ def interpolant_max(values, vinv, wc, wd):
         if values[q] > values[k]:
             k = q
     cheb_coefficients(values, vinv, wc)
-    # derivative series (numpy's chebder) into wd[0 : n - 1]
-    for q in range(n):
-        wd[q] = 0.0
-    for j in range(n - 1, 0, -1):
-        wd[j - 1] = 2.0 * j * wc[j] + (wd[j + 1] if j + 1 < n - 1 else 0.0)
-    wd[0] *= 0.5
+    derivative(wc, wd)
     best_s = 0.5 * (1.0 - math.cos(math.pi * k / (n - 1)))
     best = values[k]
     for side in range(2):
