@@ -368,3 +368,22 @@ def test_settle_event():
     earlier = [excess(x[0, 2], v[0, 2]) for x, v, touching in run.states if touching[0]]
     assert len(earlier) > 100 and min(earlier) >= e_settle
     assert sum(c.ball == "a" for c in run.contacts) >= 3  # it bounced before settling
+
+
+def test_full_buffers_are_grown_and_the_run_goes_on():
+    """With room for only 50 force rows and 2 kink-log rows, the wrapper grows the buffers
+    when the kernel reports them full and continues: same rows, kinks and state as a run with
+    large buffers (the step sequence does not depend on where the kernel returned)."""
+    law = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0)
+    ball = Ball("A", COAL, 0.03, (0.0, 0.0, 0.031), (0.0, 0.0, -2.0))
+    runs = []
+    for rows, log in ((50, 2), (100_000, 100)):
+        s = ActiveSet([ball.position], [ball.velocity], [ball.mass], [ball.radius], [(0, -1)],
+                      [law], (0.0, 0.0, -9.81), (0.3, 0.3), rtol=1e-10, row_capacity=rows,
+                      log_capacity=log)  # fmt: skip
+        start = s.advance(0.0, 1.0)
+        end = s.advance(start.t, 1.0)
+        runs.append((end.t, s.y.copy(), s.force_rows().copy(), s.kink_log()))
+    assert runs[0][2].shape[0] > 500 and len(runs[0][3]) == 2
+    assert runs[0][0] == runs[1][0] and np.array_equal(runs[0][1], runs[1][1])
+    assert np.array_equal(runs[0][2], runs[1][2]) and runs[0][3] == runs[1][3]
