@@ -16,7 +16,7 @@ The fast stream solver's driver advances balls in free flight in closed form and
 * SETTLE is checked at accepted step ends only: a ball whose only touching pair is the plate
   and whose normal excess energy over the static state (``active_pairs.settle_excess``)
   falls below its settle energy;
-* a growing buffer of plate force rows (t, pair, F): every accepted step end, ``nodes``
+* a growing buffer of plate force rows (t, pair, F): every accepted step end, ``nodes_per_step``
   equally spaced interior points of each step (dense output), contact start and end (the end
   row repeats the time of the last step end); and a log of the kinks (t, kind, pair).
 
@@ -80,14 +80,21 @@ class ActiveSet:
     kg; radius (n,) m; pairs: (P, 2) ball indices (j = -1: the plate); laws: P ``ImpactLaw``s
     (or a (P, 5) ``law_table``); gravity (3,) m/s^2 in the plate frame; half_sizes (a/2, b/2)
     m; settle_energy (n,) J (0 = never); rtol; atol_x (m), atol_v (m/s) (default rtol x 1 mm,
-    rtol x 1 m/s, as the reference); max_steps per ``advance`` call; nodes: interior force
+    rtol x 1 m/s, as the reference); max_steps per ``advance`` call; nodes_per_step: interior force
     rows per step. Per-pair state (in/out): touching, ramp, clamped, peak (N), t_peak (s),
     pen (m, max penetration). ``alive`` (n,): balls still integrated (False after a leave).
+
+    For the driver: pairs overlapping at construction start touching (``open_overlapping``,
+    region from the state, accumulators reset): overwrite the per-pair arrays to carry a
+    contact over from another set. After a START the next call's first step is the small
+    start-up step (``self.h``; pass it on as ``h`` if the set is rebuilt). START/END leave
+    the pair's accumulators (peak, t_peak, pen) for the caller to read. After a LEAVE call
+    ``remove_ball``.
     """
 
     def __init__(self, x, v, mass, radius, pairs, laws, gravity, half_sizes, *,
                  settle_energy=None, rtol=1e-10, atol_x=None, atol_v=None, max_steps=100_000,
-                 nodes=DEFAULT_NODES, row_capacity=4096, log_capacity=256):  # fmt: skip
+                 nodes_per_step=DEFAULT_NODES, row_capacity=4096, log_capacity=256):  # fmt: skip
         x = np.asarray(x, dtype=float).reshape(-1, 3)
         n = x.shape[0]
         self.y = np.concatenate([x.ravel(), np.asarray(v, dtype=float).reshape(n, 3).ravel()])
@@ -100,7 +107,7 @@ class ActiveSet:
         if not isinstance(laws, np.ndarray):
             laws = law_table(laws)
         self.law = np.ascontiguousarray(laws, dtype=float).reshape(-1, 5)
-        _check(n, self.pi, self.pj, self.law, rtol, nodes, max_steps)
+        _check(n, self.pi, self.pj, self.law, rtol, nodes_per_step, max_steps)
         self.rsum = self.radius[self.pi] + np.where(self.pj >= 0, self.radius[self.pj], 0.0)
         self.g = np.asarray(gravity, dtype=float).reshape(3).copy()
         self.half = np.asarray(half_sizes, dtype=float).reshape(2).copy()
@@ -117,7 +124,7 @@ class ActiveSet:
         self.rtol = float(rtol)
         self.atol_x = rtol * 1e-3 if atol_x is None else float(atol_x)
         self.atol_v = rtol * 1.0 if atol_v is None else float(atol_v)
-        self.max_steps, self.nodes = int(max_steps), int(nodes)
+        self.max_steps, self.nodes = int(max_steps), int(nodes_per_step)
         self.tab = dop853_tables()
         self.tab = (self.tab[0], self.tab[1], self.tab[3], self.tab[4], self.tab[5])
         self.pts, self.vinv = cheb_tables()
@@ -240,10 +247,13 @@ class ActiveSet:
 
 
 def _check(n, pi, pj, law, rtol, nodes, max_steps):
+    """InputError naming the argument that breaks its rule."""
     if not 1e-14 <= rtol <= 1e-3:
         raise InputError("rtol", f"must lie in [1e-14, 1e-3], got {rtol!r}")
-    if nodes < 0 or max_steps < 1:
-        raise InputError("nodes", "must be >= 0 (and max_steps >= 1)")
+    if nodes < 0:
+        raise InputError("nodes_per_step", f"must be >= 0, got {nodes!r}")
+    if max_steps < 1:
+        raise InputError("max_steps", f"must be >= 1, got {max_steps!r}")
     if len(law) != len(pi):
         raise InputError("laws", f"one law per pair: got {len(law)} laws for {len(pi)} pairs")
     if np.any(pi < 0) or np.any(pi >= n) or np.any(pj >= n) or np.any(pj < -1):
