@@ -41,6 +41,8 @@ from tailbeam.solvers.cheb_events import (
     certified,
     cheb_coefficients,
     first_crossing,
+    illinois_point,
+    illinois_update,
     interpolant_max,
 )
 from tailbeam.solvers.jit import helper_njit
@@ -163,21 +165,10 @@ def _sampled_crossing(kind, idx, vals, fresh, y, coef, pts, model, pstate, tmp):
             for _ in range(200):
                 if hi - lo <= 4.0 * EPS:
                     break
-                sm = (lo * ghi - hi * glo) / (ghi - glo)
-                if not (lo < sm < hi):
-                    sm = 0.5 * (lo + hi)
+                sm = illinois_point(lo, glo, hi, ghi)
                 _dense(coef, y, sm, tmp)
                 gm = row_value(kind, idx, tmp, model, pstate)
-                if gm > 0.0:
-                    lo, glo = sm, gm
-                    if side == -1:
-                        ghi *= 0.5
-                    side = -1
-                else:
-                    hi, ghi = sm, gm
-                    if side == 1:
-                        glo *= 0.5
-                    side = 1
+                lo, glo, hi, ghi, side = illinois_update(lo, glo, hi, ghi, side, sm, gm)
             return 0.5 * (lo + hi)
     return math.inf
 
@@ -398,6 +389,21 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
 
 
 @helper_njit
+def _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
+    """Apply the event of row (k, i) at (t, y), remember the row as fresh (its function sits
+    on 0 at the restart) and, after a kink handled here, recompute f0 = f(y) in the new
+    region. Returns (status or -1, nfresh)."""
+    status = _apply(k, i, t, y, model, pstate, rows, log, iout)
+    if nfresh < MAX_FRESH:
+        fresh[nfresh, 0], fresh[nfresh, 1] = k, i
+        nfresh += 1
+    if status < 0:
+        rhs(y, model, pstate, f0)
+        iout[IO_NFEV] += 1
+    return status, nfresh
+
+
+@helper_njit
 def _settle(y, model, pstate, count, plate_pair):
     """First ball whose only touching pair is the plate and whose excess energy
     (``settle_excess``) is below its settle energy; -1 if none. Checked at step ends."""
@@ -477,14 +483,10 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
             k, i = pend_k, pend_i
             pend_k = -1
             if row_value(k, i, y, model, pstate) <= 2.0 * row_band(k, i, model[7]):
-                status = _apply(k, i, t, y, model, pstate, rows, log, iout)
-                if nfresh < MAX_FRESH:
-                    fresh[nfresh, 0], fresh[nfresh, 1] = k, i
-                    nfresh += 1
+                status, nfresh = _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh,
+                                             nfresh, f0)  # fmt: skip
                 if status >= 0:
                     break
-                rhs(y, model, pstate, f0)
-                iout[IO_NFEV] += 1
             continue
         if attempts >= max_steps:
             status = ST_STEP_LIMIT
@@ -540,14 +542,10 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
             continue
         t_e = t + s * hh
         if t_e <= t + 4.0 * EPS * abs(t) or s == 0.0:  # at the restart: apply there
-            status = _apply(k, i, t, y, model, pstate, rows, log, iout)
-            if nfresh < MAX_FRESH:
-                fresh[nfresh, 0], fresh[nfresh, 1] = k, i
-                nfresh += 1
+            status, nfresh = _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh,
+                                         f0)  # fmt: skip
             if status >= 0:
                 break
-            rhs(y, model, pstate, f0)
-            iout[IO_NFEV] += 1
             continue
         pend_k, pend_i, pend_t = k, i, t_e  # redo the step to end exactly at the event
         h = t_e - t

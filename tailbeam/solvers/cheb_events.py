@@ -90,26 +90,35 @@ def _g(c, s):
 
 
 @helper_njit
+def illinois_point(lo, glo, hi, ghi):
+    """Next point of the Illinois (modified regula falsi) method in (lo, hi); the midpoint if
+    the secant falls outside."""
+    sm = (lo * ghi - hi * glo) / (ghi - glo)
+    return sm if lo < sm < hi else 0.5 * (lo + hi)
+
+
+@helper_njit
+def illinois_update(lo, glo, hi, ghi, side, sm, gm):
+    """The bracket (lo, glo, hi, ghi, side) after the value gm at sm (g(lo) > 0 >= g(hi));
+    the end kept twice in a row has its value halved (Illinois)."""
+    if gm > 0.0:
+        if side == -1:
+            ghi *= 0.5
+        return sm, gm, hi, ghi, -1
+    if side == 1:
+        glo *= 0.5
+    return lo, glo, sm, gm, 1
+
+
+@helper_njit
 def illinois(c, lo, glo, hi, ghi):
     """Root of the series c (in s) in [lo, hi] with g(lo) > 0 >= g(hi); to 4 ulp of s."""
     side = 0
     for _ in range(200):
         if hi - lo <= 4.0 * 2.220446049250313e-16 * max(1.0, abs(hi)):
             break
-        sm = (lo * ghi - hi * glo) / (ghi - glo)
-        if not (lo < sm < hi):
-            sm = 0.5 * (lo + hi)
-        gm = _g(c, sm)
-        if gm > 0.0:
-            lo, glo = sm, gm
-            if side == -1:
-                ghi *= 0.5
-            side = -1
-        else:
-            hi, ghi = sm, gm
-            if side == 1:
-                glo *= 0.5
-            side = 1
+        sm = illinois_point(lo, glo, hi, ghi)
+        lo, glo, hi, ghi, side = illinois_update(lo, glo, hi, ghi, side, sm, _g(c, sm))
     return 0.5 * (lo + hi)
 
 
