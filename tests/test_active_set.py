@@ -389,3 +389,24 @@ def test_full_buffers_are_grown_and_the_run_goes_on():
     assert runs[0][2].shape[0] > 500 and len(runs[0][3]) == 2
     assert runs[0][0] == runs[1][0] and np.array_equal(runs[0][1], runs[1][1])
     assert np.array_equal(runs[0][2], runs[1][2]) and runs[0][3] == runs[1][3]
+
+
+@pytest.mark.parametrize(
+    "change, field",
+    [({"rtol": 1.0}, "rtol"), ({"pairs": [(0, 3)]}, "pairs"), ({"pairs": [(0, 0)]}, "pairs"),
+     ({"radius": [0.0]}, "radius"), ({"settle_energy": [-1.0]}, "settle_energy"),
+     ({"nodes_per_step": -1}, "nodes_per_step"), ({"max_steps": 0}, "max_steps"),
+     ({"laws": []}, "laws")],
+)  # fmt: skip
+def test_bad_input_names_the_argument(change, field):
+    """Each rule broken gives an InputError naming the argument, before any work."""
+    from tailbeam.errors import InputError
+
+    law = ball_plate_law(COAL, 0.03, CARBON_STEEL)
+    args = dict(x=[(0.0, 0.0, 0.05)], v=[(0.0, 0.0, -1.0)], mass=[0.1], radius=[0.03],
+                pairs=[(0, -1)], laws=[law], gravity=(0.0, 0.0, -9.81),
+                half_sizes=(0.3, 0.3))  # fmt: skip
+    args.update(change)
+    with pytest.raises(InputError) as err:
+        ActiveSet(**args)
+    assert err.value.field == field

@@ -108,11 +108,16 @@ class ActiveSet:
             laws = law_table(laws)
         self.law = np.ascontiguousarray(laws, dtype=float).reshape(-1, 5)
         _check(n, self.pi, self.pj, self.law, rtol, nodes_per_step, max_steps)
+        _check_positive("mass", self.mass)
+        _check_positive("radius", self.radius)
         self.rsum = self.radius[self.pi] + np.where(self.pj >= 0, self.radius[self.pj], 0.0)
         self.g = np.asarray(gravity, dtype=float).reshape(3).copy()
         self.half = np.asarray(half_sizes, dtype=float).reshape(2).copy()
+        _check_positive("half_sizes", self.half)
         settle = np.zeros(n) if settle_energy is None else settle_energy
         self.settle_energy = np.asarray(settle, dtype=float).reshape(n).copy()
+        if not np.all(self.settle_energy >= 0.0):
+            raise InputError("settle_energy", "must be >= 0 J for every ball (0 = never)")
         self.alive = np.ones(n, dtype=bool)
         p = len(self.pi)
         self.touching = np.zeros(p, dtype=bool)
@@ -244,6 +249,11 @@ class ActiveSet:
         """Accepted steps, attempted steps and right-hand-side evaluations so far."""
         return {"steps": int(self.iout[ak.IO_STEPS]), "attempts": int(self.iout[ak.IO_ATTEMPTS]),
                 "nfev": int(self.iout[ak.IO_NFEV])}  # fmt: skip
+
+
+def _check_positive(name, values):
+    if not np.all(np.isfinite(values)) or not np.all(values > 0.0):
+        raise InputError(name, f"must be finite and > 0, got {values.tolist()!r}")
 
 
 def _check(n, pi, pj, law, rtol, nodes, max_steps):
