@@ -87,7 +87,7 @@ def _step(y, h, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp):
     A, B, E3, E5 = tab[0], tab[1], tab[2], tab[3]
     n = y.shape[0]
     nb = n // 2  # positions first, then velocities
-    _stages(K, A, 1, 12, y, h, model, pstate, tmp)
+    _stages(K, A, np.int64(1), np.int64(12), y, h, model, pstate, tmp)
     for q in range(n):
         acc = 0.0
         for j in range(12):
@@ -114,7 +114,7 @@ def _step(y, h, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp):
 def _dense_coef(y, ynew, h, K, tab, model, pstate, coef, tmp):
     """The 3 extra stages and the 7 rows of DOP853's dense output (scipy's F)."""
     A, D = tab[0], tab[4]
-    _stages(K, A, 13, 16, y, h, model, pstate, tmp)
+    _stages(K, A, np.int64(13), np.int64(16), y, h, model, pstate, tmp)
     for q in range(y.shape[0]):
         dy = ynew[q] - y[q]
         coef[0, q] = dy
@@ -161,7 +161,7 @@ def _sampled_crossing(kind, idx, vals, fresh, y, coef, pts, model, pstate, tmp):
     for q in range(1, pts.shape[0]):
         if vals[q - 1] > 0.0 and vals[q] <= 0.0:
             lo, glo, hi, ghi = pts[q - 1], vals[q - 1], pts[q], vals[q]
-            side = 0
+            side = np.int64(0)  # (not a literal: one compiled signature)
             for _ in range(200):
                 if hi - lo <= 4.0 * EPS:
                     break
@@ -282,11 +282,13 @@ def _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
                               tmp, model, pstate)  # fmt: skip
             if s < best_s:
                 best_s, best_k, best_i = s, kind, p
+    kind_edge = np.int64(R_EDGE)  # (typed like the pair kinds: one compiled signature)
     for b in range(n):
         if not alive[b]:
             continue
         for e in range(4):
-            s = _row_crossing(R_EDGE, 4 * b + e, False, Y15, have, coef, y, B, pts, vinv, n,
+            fr = _is_fresh(kind_edge, 4 * b + e, fresh, nfresh)  # (False: LEAVE returns)
+            s = _row_crossing(kind_edge, 4 * b + e, fr, Y15, have, coef, y, B, pts, vinv, n,
                               half, pi, pj, law, rsum, touching, ramp, clamped, vals, wc, wv,
                               wc2, wd, stack, tmp, model, pstate)  # fmt: skip
             if s < best_s:
@@ -465,12 +467,12 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
     count = np.zeros(nb, dtype=np.int64)
     plate_pair = np.zeros(nb, dtype=np.int64)
     fresh = np.zeros((MAX_FRESH, 2), dtype=np.int64)
-    nfresh = 0
+    nfresh = np.int64(0)  # (typed int64, not a literal: one compiled signature per helper)
     t, h = tio[0], tio[1]
     rhs(y, model, pstate, K[0])
     iout[IO_NFEV] += 1
     f0 = K[0].copy()
-    pend_k, pend_i, pend_t = -1, -1, 0.0
+    pend_k, pend_i, pend_t = np.int64(-1), np.int64(-1), 0.0  # the pending event
     rejected = False
     attempts = 0
     status = -1
@@ -481,7 +483,7 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
                 status = ST_STOP
                 break
             k, i = pend_k, pend_i
-            pend_k = -1
+            pend_k = np.int64(-1)
             if row_value(k, i, y, model, pstate) <= 2.0 * row_band(k, i, model[7]):
                 status, nfresh = _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh,
                                              nfresh, f0)  # fmt: skip
@@ -531,7 +533,7 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
             t = t_bound if last else t + hh
             y[:] = ynew
             f0[:] = K[12]
-            nfresh = 0
+            nfresh = np.int64(0)  # (typed int64, not a literal: one compiled signature per helper)
             h = hh * factor
             iout[IO_STEPS] += 1
             b = _settle(y, model, pstate, count, plate_pair)

@@ -113,7 +113,7 @@ def illinois_update(lo, glo, hi, ghi, side, sm, gm):
 @helper_njit
 def illinois(c, lo, glo, hi, ghi):
     """Root of the series c (in s) in [lo, hi] with g(lo) > 0 >= g(hi); to 4 ulp of s."""
-    side = 0
+    side = np.int64(0)  # (not a literal: one compiled signature)
     for _ in range(200):
         if hi - lo <= 4.0 * 2.220446049250313e-16 * max(1.0, abs(hi)):
             break
