@@ -32,7 +32,8 @@ class SceneRun:
     def __init__(self, balls, incline, duration, *, sample=None, settle_energy=None, **kwargs):
         self.balls, self.incline = balls, incline
         self.names = [b.name for b in balls]
-        options = {k: kwargs.pop(k) for k in ("damping", "penetration", "clamp") if k in kwargs}
+        law_keys = ("damping", "penetration", "clamp", "exponent")
+        options = {k: kwargs.pop(k) for k in law_keys if k in kwargs}
         pairs = reference_pairs(len(balls))
         self.set = ActiveSet.from_balls(
             balls, pairs, incline, settle_energy=settle_energy, **options, **kwargs
