@@ -1,9 +1,13 @@
 """Compiled (numba) DOP853 integrator of an active set of balls, with certified events.
 
 One call advances the state from t until the first structural event or t_stop (see
-``advance``). Per step: 12 + 3 right-hand-side evaluations (O(balls + touching pairs) each),
-the dense output at the 15 Chebyshev points of the step, and every watched row (pairs and
-edges: O(pairs watched + balls)) certified or searched (``cheb_events``).
+``advance``). Per step: 12 + 3 right-hand-side evaluations (O(balls + touching pairs) each)
+and every watched row (pairs and edges: O(pairs watched + balls)) certified in three tiers:
+the bound B on how far each state component moves in the step (``_prepare``, ``_quick``:
+O(1) for far pairs and balls far from the edges), else the 15 Chebyshev values of the row
+(the ball's dense output there, evaluated once per ball and step: ``_ensure``), else the
+first-crossing search (``cheb_events``). Helpers take arrays one by one and are compiled
+without reference counting (``tailbeam.solvers.jit``); only ``advance`` allocates.
 
 Event handling is the reference's (``stream_reference``): a step in which a row crosses is
 discarded and redone to end exactly at the crossing, and the redone step is checked again
