@@ -33,7 +33,7 @@ from tailbeam.contact_law import ball_ball_law, ball_plate_law
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.rigid.kernel import dop853_tables
 from tailbeam.solvers import active_kernel as ak
-from tailbeam.solvers.active_pairs import pair_state
+from tailbeam.solvers.active_pairs import clamp_indicator, pair_state
 from tailbeam.solvers.cheb_events import tables as cheb_tables
 
 DEFAULT_NODES = 40  # interior force rows per step: linear interpolation < 1e-5 of the peak
@@ -169,8 +169,6 @@ class ActiveSet:
     def open_overlapping(self):
         """Pairs overlapping now start touching, in their region (a ball placed at its static
         penetration), as ``stream_reference``'s ``touch``."""
-        from tailbeam.solvers.active_pairs import clamp_indicator
-
         for p in range(len(self.pi)):
             if self.touching[p] or not self.alive[self.pi[p]]:
                 continue
