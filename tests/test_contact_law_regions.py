@@ -30,3 +30,31 @@ def test_region_force_equals_the_law_inside_each_region():
     # the elastic energy is the integral of the elastic force
     work, _ = quad(lambda x: law.stiffness * x**law.exponent, 0.0, 2e-4, epsabs=0.0, epsrel=1e-12)
     assert abs(elastic_energy(2e-4, law) / work - 1.0) < 1e-8
+
+
+def test_compiled_twins_equal_the_region_helpers():
+    """The numba twins in tailbeam.solvers.active_pairs (used by the active-set kernel) give
+    the same force, clamp indicator and elastic energy as the helpers above, in every region
+    and for exponents 1, 1.5 (the x sqrt(x) branch), 2 (its own clamp limit) and 2.2."""
+    from tailbeam.contact_law import ImpactLaw
+    from tailbeam.solvers import active_pairs as ap
+
+    rng = np.random.default_rng(11)
+    for e in (1.0, 1.5, 2.0, 2.2):
+        law = ImpactLaw(3e9, e, damping=900.0, penetration=1e-4)
+        k, c, d = law.stiffness, law.damping, law.penetration
+        delta = np.concatenate([rng.uniform(1e-9, 3e-4, 400), [-1e-6, 0.0]])
+        rate = rng.uniform(-3.0, 3.0, delta.size)
+        for ramp in (True, False):
+            for clamped in (True, False):
+                ours = [ap.region_force(x, u, k, e, c, d, ramp, clamped)
+                        for x, u in zip(delta, rate, strict=True)]  # fmt: skip
+                theirs = impact_force_in_region(delta, rate, law, ramp, clamped)
+                np.testing.assert_allclose(ours, theirs, rtol=1e-13, atol=1e-9)
+            ind = [
+                ap.clamp_indicator(x, u, k, e, c, d, ramp) for x, u in zip(delta, rate, strict=True)
+            ]
+            want = [clamp_indicator(x, u, law, ramp) for x, u in zip(delta, rate, strict=True)]
+            np.testing.assert_allclose(ind, want, rtol=1e-13, atol=1e-13)
+        energy = [ap.elastic_energy(x, k, e) for x in delta]
+        np.testing.assert_allclose(energy, elastic_energy(delta, law), rtol=1e-13, atol=0.0)

@@ -1,0 +1,563 @@
+"""Compiled (numba) DOP853 integrator of an active set of balls, with certified events.
+
+One call advances the state from t until the first structural event or t_stop (see
+``advance``). Per step: 12 + 3 right-hand-side evaluations (O(balls + touching pairs) each)
+and every watched row (pairs and edges: O(pairs watched + balls)) certified in three tiers:
+the bound B on how far each state component moves in the step (``_prepare``, ``_quick``:
+O(1) for far pairs and balls far from the edges), else the 15 Chebyshev values of the row
+(the ball's dense output there, evaluated once per ball and step: ``_ensure``), else the
+first-crossing search (``cheb_events``). Helpers take arrays one by one and are compiled
+without reference counting (``tailbeam.solvers.jit``); only ``advance`` allocates.
+
+Event handling is the reference's (``stream_reference``): a step in which a row crosses is
+discarded and redone to end exactly at the crossing, and the redone step is checked again
+(an earlier root wins). At the end of the redone step the event is applied if its row is
+within its dead band of the crossing. Kinks (full damping d crossed, clamp on/off) are
+applied inside (logged) and integration goes on in the new region; contact start / end,
+leave, settle return to the caller. Events within ``SAME_TIME`` of a step of a pending one
+are taken after it, one after the other at the same time (a symmetric 3-ball cluster).
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from tailbeam.solvers.active_pairs import (
+    L_C,
+    L_CLAMP,
+    L_D,
+    R_CLAMP,
+    R_CONTACT,
+    R_EDGE,
+    R_FULL,
+    first_contact_step,
+    pair_force,
+    pair_state,
+    rhs,
+    rhs_arrays,
+    row_band,
+    row_value,
+    row_value_arrays,
+    settle_excess,
+)
+from tailbeam.solvers.cheb_events import (
+    certified,
+    cheb_coefficients,
+    first_crossing,
+    illinois_point,
+    illinois_update,
+    interpolant_max,
+)
+from tailbeam.solvers.jit import helper_njit
+
+# return status of ``advance``
+ST_STOP, ST_START, ST_END, ST_LEAVE, ST_SETTLE, ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = range(8)
+STATUS_NAMES = (
+    "t_stop", "contact_start", "contact_end", "leave", "settle", "buffer_full", "step_limit",
+    "step_too_small",
+)  # fmt: skip
+# kinds in the event log
+LOG_FULL, LOG_CLAMP_ON, LOG_CLAMP_OFF = range(3)
+LOG_NAMES = ("full_damping", "clamp_on", "clamp_off")
+# integer outputs (iout)
+IO_STATUS, IO_INDEX, IO_EDGE, IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_ROWS, IO_LOG = range(8)
+
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
+SAME_TIME = 1e-9  # fraction of a step: events closer than this to a pending one wait for it
+EPS = 2.220446049250313e-16
+MAX_FRESH = 16
+
+
+@helper_njit
+def _stages(K, A, first, stop, y, h, model, pstate, tmp):
+    """Runge-Kutta stages first..stop-1 into K (rows: stages)."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
+    n = y.shape[0]
+    for s in range(first, stop):
+        for q in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += A[s, j] * K[j, q]
+            tmp[q] = y[q] + h * acc
+        rhs_arrays(tmp, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, K[s])
+
+
+@helper_njit
+def _step(y, h, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp):
+    """One DOP853 step of size h from y (K[0] = f(y) given): ynew, K[12] = f(ynew); returns
+    scipy's error norm (NaN or > 1: reject)."""
+    A, B, E3, E5 = tab[0], tab[1], tab[2], tab[3]
+    n = y.shape[0]
+    nb = n // 2  # positions first, then velocities
+    _stages(K, A, np.int64(1), np.int64(12), y, h, model, pstate, tmp)
+    for q in range(n):
+        acc = 0.0
+        for j in range(12):
+            acc += B[j] * K[j, q]
+        ynew[q] = y[q] + h * acc
+    rhs(ynew, model, pstate, K[12])
+    err5 = 0.0
+    err3 = 0.0
+    for q in range(n):
+        e5 = 0.0
+        e3 = 0.0
+        for j in range(13):
+            e5 += E5[j] * K[j, q]
+            e3 += E3[j] * K[j, q]
+        sc = (atol_x if q < nb else atol_v) + rtol * max(abs(y[q]), abs(ynew[q]))
+        err5 += (e5 / sc) ** 2
+        err3 += (e3 / sc) ** 2
+    if err5 == 0.0 and err3 == 0.0:
+        return 0.0
+    return h * err5 / math.sqrt((err5 + 0.01 * err3) * n)
+
+
+@helper_njit
+def _dense_coef(y, ynew, h, K, tab, model, pstate, coef, tmp):
+    """The 3 extra stages and the 7 rows of DOP853's dense output (scipy's F)."""
+    A, D = tab[0], tab[4]
+    _stages(K, A, np.int64(13), np.int64(16), y, h, model, pstate, tmp)
+    for q in range(y.shape[0]):
+        dy = ynew[q] - y[q]
+        coef[0, q] = dy
+        coef[1, q] = h * K[0, q] - dy
+        coef[2, q] = 2.0 * dy - h * (K[12, q] + K[0, q])
+        for i in range(4):
+            acc = 0.0
+            for j in range(16):
+                acc += D[i, j] * K[j, q]
+            coef[3 + i, q] = h * acc
+
+
+@helper_njit
+def _dense1(coef, y, s, q):
+    """Component q of the dense output at fraction s of the step."""
+    a = 0.0
+    for i in range(6, -1, -1):
+        a += coef[i, q]
+        a *= s if (6 - i) % 2 == 0 else 1.0 - s
+    return y[q] + a
+
+
+@helper_njit
+def _dense(coef, y, s, out):
+    for q in range(y.shape[0]):
+        out[q] = _dense1(coef, y, s, q)
+
+
+@helper_njit
+def _is_fresh(kind, idx, fresh, nfresh):
+    for f in range(nfresh):
+        if fresh[f, 0] == kind and fresh[f, 1] == idx:
+            return True
+    return False
+
+
+@helper_njit
+def _sampled_crossing(kind, idx, vals, fresh, y, coef, pts, model, pstate, tmp):
+    """First s where a sampled (non-polynomial) row leaves its side: a node on the wrong side
+    right after one on the right side, closed by Illinois on the dense output. A fresh row
+    may start on the wrong side by round-off: only a right-to-wrong change counts for it."""
+    if not fresh and vals[0] <= 0.0:
+        return 0.0
+    for q in range(1, pts.shape[0]):
+        if vals[q - 1] > 0.0 and vals[q] <= 0.0:
+            lo, glo, hi, ghi = pts[q - 1], vals[q - 1], pts[q], vals[q]
+            side = np.int64(0)  # (not a literal: one compiled signature)
+            for _ in range(200):
+                if hi - lo <= 4.0 * EPS:
+                    break
+                sm = illinois_point(lo, glo, hi, ghi)
+                _dense(coef, y, sm, tmp)
+                gm = row_value(kind, idx, tmp, model, pstate)
+                lo, glo, hi, ghi, side = illinois_update(lo, glo, hi, ghi, side, sm, gm)
+            return 0.5 * (lo + hi)
+    return math.inf
+
+
+@helper_njit
+def _prepare(dense):
+    """Start of a step's event work: no ball evaluated at the Chebyshev points yet, and the
+    bound B[q] = sum_i |coef[i, q]| >= |y_q(s) - y_q(0)| on the whole step (every factor of
+    the dense output's nested form lies in [0, 1])."""
+    Y15, have, coef, y, B = dense
+    for b in range(have.shape[0]):
+        have[b] = False
+    for q in range(y.shape[0]):
+        acc = 0.0
+        for i in range(7):
+            acc += abs(coef[i, q])
+        B[q] = acc
+
+
+@helper_njit
+def _ensure(Y15, have, coef, y, pts, b):
+    """Ball b's 6 state components at the 15 Chebyshev points of the step (once per step)."""
+    if b < 0 or have[b]:
+        return
+    have[b] = True
+    n = have.shape[0]
+    for q in range(pts.shape[0]):
+        for k in range(3):
+            Y15[q, 3 * b + k] = _dense1(coef, y, pts[q], 3 * b + k)
+            Y15[q, 3 * n + 3 * b + k] = _dense1(coef, y, pts[q], 3 * n + 3 * b + k)
+
+
+@helper_njit
+def _reach(B, b):
+    """Bound in m on how far ball b's centre moves from its start during the step."""
+    return math.sqrt(B[3 * b] ** 2 + B[3 * b + 1] ** 2 + B[3 * b + 2] ** 2)
+
+
+@helper_njit
+def _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp):
+    """Whether row (kind, idx) is certified positive on the step by the bound B alone:
+    edges and centre distances move at most B from their start values (no 15-point
+    evaluation needed: far-apart pairs and balls far from the edges cost O(1))."""
+    if kind == R_CLAMP:
+        return False
+    if kind == R_EDGE:
+        b, e = idx // 4, idx % 4
+        c = y[3 * b + e // 2]
+        f = c + half[e // 2] if e % 2 == 0 else half[e // 2] - c
+        return f + 1e-13 - B[3 * b + e // 2] > 0.0  # (EDGE_BAND)
+    i, j, rs = pi[idx], pj[idx], rsum[idx]
+    if j < 0:
+        dist0, reach = y[3 * i + 2], B[3 * i + 2]
+    else:
+        dist0 = rs - pair_state(y, n, i, j, rs)[0]
+        reach = _reach(B, i) + _reach(B, j)
+    lo, hi = dist0 - reach, dist0 + reach  # the distance stays within [lo, hi]
+    margin = 1e-12 * rs
+    if kind == R_CONTACT:
+        return hi < rs - margin and lo > 0.0 if touching[idx] else lo > rs + margin
+    r_full = rs - law[idx, L_D]
+    return lo > r_full + margin if ramp[idx] else (hi < r_full - margin and lo > 0.0)
+
+
+@helper_njit
+def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, pj, law,
+                  rsum, touching, ramp, clamped, vals, wc, wv, wc2, wd, stack, tmp, model,
+                  pstate):  # fmt: skip
+    """First crossing (fraction of the step, inf if none) of row (kind, idx): the bound B,
+    else the 15-point certificate, else the search (``cheb_events``)."""
+    if _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp):
+        return math.inf
+    if kind == R_EDGE:
+        _ensure(Y15, have, coef, y, pts, idx // 4)
+    else:
+        _ensure(Y15, have, coef, y, pts, pi[idx])
+        _ensure(Y15, have, coef, y, pts, pj[idx])
+    for q in range(pts.shape[0]):
+        vals[q] = row_value_arrays(
+            kind, idx, Y15[q], n, half, pi, pj, law, rsum, touching, ramp, clamped
+        )
+    if kind == R_CLAMP:
+        return _sampled_crossing(kind, idx, vals, fr, y, coef, pts, model, pstate, tmp)
+    cheb_coefficients(vals, vinv, wc)
+    if certified(wc):
+        return math.inf
+    return first_crossing(wc, vals, fr, pts, vinv, wv, wc2, wd, stack)
+
+
+@helper_njit
+def _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
+    """Earliest (s, kind, idx) of a row crossing in the step; kind -1 if none. (The tuples
+    are unpacked once here: the helpers take arrays, see ``rhs_arrays``.)"""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
+    Y15, have, coef, y, B = dense
+    vals, wc, wv, wc2, wd, stack, tmp = ws
+    n = mass.shape[0]
+    best_s, best_k, best_i = math.inf, -1, -1
+    for p in range(pi.shape[0]):
+        if not alive[pi[p]] or (pj[p] >= 0 and not alive[pj[p]]):
+            continue
+        for kind in range(3):
+            if kind > 0 and (not touching[p] or law[p, L_C] <= 0.0):
+                break
+            if kind == R_CLAMP and law[p, L_CLAMP] <= 0.0:
+                break
+            fr = _is_fresh(kind, p, fresh, nfresh)
+            s = _row_crossing(kind, p, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, pj,
+                              law, rsum, touching, ramp, clamped, vals, wc, wv, wc2, wd, stack,
+                              tmp, model, pstate)  # fmt: skip
+            if s < best_s:
+                best_s, best_k, best_i = s, kind, p
+    kind_edge = np.int64(R_EDGE)  # (typed like the pair kinds: one compiled signature)
+    for b in range(n):
+        if not alive[b]:
+            continue
+        for e in range(4):
+            fr = _is_fresh(kind_edge, 4 * b + e, fresh, nfresh)  # (False: LEAVE returns)
+            s = _row_crossing(kind_edge, 4 * b + e, fr, Y15, have, coef, y, B, pts, vinv, n,
+                              half, pi, pj, law, rsum, touching, ramp, clamped, vals, wc, wv,
+                              wc2, wd, stack, tmp, model, pstate)  # fmt: skip
+            if s < best_s:
+                best_s, best_k, best_i = s, R_EDGE, 4 * b + e
+    return best_s, best_k, best_i
+
+
+@helper_njit
+def _write_row(rows, iout, t, p, f):
+    r = iout[IO_ROWS]
+    rows[r, 0] = t
+    rows[r, 1] = p
+    rows[r, 2] = f
+    iout[IO_ROWS] = r + 1
+
+
+@helper_njit
+def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
+    """Peak force / max penetration of the touching pairs on the accepted step (maximum of
+    their Chebyshev interpolant, refined where the nodes come within 1 % of the record), and
+    the plate force rows at ``nodes`` interior points and the step end."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    touching, ramp, clamped, peak, t_peak, pen = pstate
+    vals, wc, wv, wc2, wd, stack, tmp = ws
+    Y15, have, coef, y, B = dense
+    n = mass.shape[0]
+    for p in range(pi.shape[0]):
+        if not touching[p]:
+            continue
+        _ensure(Y15, have, coef, y, pts, pi[p])
+        _ensure(Y15, have, coef, y, pts, pj[p])
+        fmax = -math.inf
+        for q in range(pts.shape[0]):
+            f, delta, _, _, _ = pair_force(Y15[q], n, p, pi, pj, law, rsum, ramp, clamped)
+            vals[q] = f
+            wv[q] = delta
+            fmax = max(fmax, f)
+        if fmax >= 0.99 * peak[p]:
+            s, fm = interpolant_max(vals, vinv, wc, wc2)
+            if fm > peak[p]:
+                peak[p], t_peak[p] = fm, t + s * h
+        dmax = -math.inf
+        for q in range(pts.shape[0]):
+            dmax = max(dmax, wv[q])
+        if dmax >= 0.99 * pen[p]:
+            for q in range(pts.shape[0]):
+                vals[q] = wv[q]
+            pen[p] = max(pen[p], interpolant_max(vals, vinv, wc, wc2)[1])
+        if pj[p] >= 0:
+            continue
+        i = pi[p]
+        for k in range(1, nodes + 1):
+            s = k / (nodes + 1.0)
+            tmp[3 * i + 2] = _dense1(coef, y, s, 3 * i + 2)
+            tmp[3 * n + 3 * i + 2] = _dense1(coef, y, s, 3 * n + 3 * i + 2)
+            f = pair_force(tmp, n, p, pi, pj, law, rsum, ramp, clamped)[0]
+            _write_row(rows, iout, t + s * h, p, f)
+        f = pair_force(ynew, n, p, pi, pj, law, rsum, ramp, clamped)[0]
+        _write_row(rows, iout, t + h, p, f)
+
+
+@helper_njit
+def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
+    """Apply the event of row (kind, idx) at time t, state y; returns the status to return
+    with (ST_START, ST_END, ST_LEAVE) or -1 for a kink handled here (logged)."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    touching, ramp, clamped, peak, t_peak, pen = pstate
+    n = mass.shape[0]
+    if kind == R_EDGE:
+        iout[IO_INDEX] = idx // 4
+        iout[IO_EDGE] = idx % 4
+        return ST_LEAVE
+    iout[IO_INDEX] = idx
+    if kind == R_CONTACT:
+        f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped)[0]
+        if touching[idx]:
+            if pj[idx] < 0:
+                _write_row(rows, iout, t, idx, f)
+            touching[idx] = False
+            return ST_END
+        touching[idx], ramp[idx], clamped[idx] = True, True, False
+        delta = pair_state(y, n, pi[idx], pj[idx], rsum[idx])[0]
+        peak[idx], t_peak[idx], pen[idx] = 0.0, math.nan, max(0.0, delta)
+        if pj[idx] < 0:
+            _write_row(
+                rows, iout, t, idx, pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped)[0]
+            )
+        return ST_START
+    r = iout[IO_LOG]
+    if kind == R_FULL:
+        ramp[idx] = not ramp[idx]
+        log[r, 1] = LOG_FULL
+    else:
+        clamped[idx] = not clamped[idx]
+        log[r, 1] = LOG_CLAMP_ON if clamped[idx] else LOG_CLAMP_OFF
+    log[r, 0] = t
+    log[r, 2] = idx
+    iout[IO_LOG] = r + 1
+    return -1
+
+
+@helper_njit
+def _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
+    """Apply the event of row (k, i) at (t, y), remember the row as fresh (its function sits
+    on 0 at the restart) and, after a kink handled here, recompute f0 = f(y) in the new
+    region. Returns (status or -1, nfresh)."""
+    status = _apply(k, i, t, y, model, pstate, rows, log, iout)
+    if nfresh < MAX_FRESH:
+        fresh[nfresh, 0], fresh[nfresh, 1] = k, i
+        nfresh += 1
+    if status < 0:
+        rhs(y, model, pstate, f0)
+        iout[IO_NFEV] += 1
+    return status, nfresh
+
+
+@helper_njit
+def _settle(y, model, pstate, count, plate_pair):
+    """First ball whose only touching pair is the plate and whose excess energy
+    (``settle_excess``) is below its settle energy; -1 if none. Checked at step ends."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    touching = pstate[0]
+    n = mass.shape[0]
+    for b in range(n):
+        count[b] = 0
+        plate_pair[b] = -1
+    for p in range(pi.shape[0]):
+        if touching[p]:
+            count[pi[p]] += 1
+            if pj[p] >= 0:
+                count[pj[p]] += 1
+            else:
+                plate_pair[pi[p]] = p
+    for b in range(n):
+        if e_settle[b] > 0.0 and alive[b] and count[b] == 1 and plate_pair[b] >= 0:
+            if settle_excess(y, model, plate_pair[b], b) < e_settle[b]:
+                return b
+    return -1
+
+
+@helper_njit
+def _rows_needed(model, pstate, nodes):
+    """Force rows one more step (and its events) may write: (nodes + 1) per touching plate
+    pair, plus a start and an end row."""
+    pi, pj = model[4], model[5]
+    touching = pstate[0]
+    m = 0
+    for p in range(pi.shape[0]):
+        if touching[p] and pj[p] < 0:
+            m += 1
+    return (nodes + 1) * m + 2
+
+
+@njit(cache=True)
+def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstate, tab,
+            pts, vinv, rows, log, iout):  # fmt: skip
+    """Advance the active set from tio[0] with first step tio[1] until an event or t_stop.
+
+    y (6 n,) state in/out. model = (mass, radius, g (3,), half (2,), pi, pj, law (P, 5), rsum,
+    e_settle, alive), pstate = (touching, ramp, clamped, peak, t_peak, pen): per-pair in/out.
+    tab = DOP853 (A, B, E3, E5, D). rows (R, 3) force rows (t, pair, F) and log (L, 3) kinks
+    (t, kind, pair) are appended from iout[IO_ROWS], iout[IO_LOG]. On return: tio = [t, next
+    step], iout[IO_STATUS] (ST_*), iout[IO_INDEX] (pair or ball), iout[IO_EDGE], work counts.
+    """
+    nst = y.shape[0]
+    K = np.zeros((16, nst))
+    ynew = np.zeros(nst)
+    tmp = np.zeros(nst)
+    coef = np.zeros((7, nst))
+    npts = pts.shape[0]
+    nb = model[0].shape[0]
+    dense = (np.zeros((npts, nst)), np.zeros(nb, dtype=np.bool_), coef, np.zeros(nst),
+             np.zeros(nst))  # fmt: skip
+    ws = (np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts),
+          np.zeros((256, 3)), np.zeros(nst))  # fmt: skip
+    count = np.zeros(nb, dtype=np.int64)
+    plate_pair = np.zeros(nb, dtype=np.int64)
+    fresh = np.zeros((MAX_FRESH, 2), dtype=np.int64)
+    nfresh = np.int64(0)  # (typed int64, not a literal: one compiled signature per helper)
+    t, h = tio[0], tio[1]
+    rhs(y, model, pstate, K[0])
+    iout[IO_NFEV] += 1
+    f0 = K[0].copy()
+    pend_k, pend_i, pend_t = np.int64(-1), np.int64(-1), 0.0  # the pending event
+    rejected = False
+    attempts = 0
+    status = -1
+    while True:
+        t_bound = pend_t if pend_k >= 0 else t_stop
+        if t >= t_bound:
+            if pend_k < 0:
+                status = ST_STOP
+                break
+            k, i = pend_k, pend_i
+            pend_k = np.int64(-1)
+            if row_value(k, i, y, model, pstate) <= 2.0 * row_band(k, i, model[7]):
+                status, nfresh = _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh,
+                                             nfresh, f0)  # fmt: skip
+                if status >= 0:
+                    break
+            continue
+        if attempts >= max_steps:
+            status = ST_STEP_LIMIT
+            break
+        if iout[IO_ROWS] + _rows_needed(model, pstate, nodes) > rows.shape[0] or (
+            iout[IO_LOG] + 2 > log.shape[0]
+        ):
+            status = ST_BUFFER
+            break
+        hh = h
+        last = False
+        if hh >= t_bound - t:
+            hh = t_bound - t
+            last = True
+        if hh <= 4.0 * EPS * abs(t):
+            if last:  # the bound is within round-off of t: snap to it
+                t = t_bound
+                continue
+            status = ST_STEP_TINY
+            break
+        attempts += 1
+        K[0, :] = f0
+        err = _step(y, hh, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp)
+        iout[IO_NFEV] += 12
+        if not err <= 1.0:
+            h = hh * (max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0)) if err > 1.0 else MIN_FACTOR)
+            rejected = True
+            continue
+        _dense_coef(y, ynew, hh, K, tab, model, pstate, coef, tmp)
+        iout[IO_NFEV] += 3
+        dense[3][:] = y
+        _prepare(dense)
+        s, k, i = _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws)
+        if k >= 0 and pend_k >= 0 and t + s * hh >= pend_t - SAME_TIME * hh:
+            k = -1  # (about) simultaneous with the pending event: taken after it
+        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** (-1.0 / 8.0))
+        if rejected:
+            factor = min(1.0, factor)
+        rejected = False
+        if k < 0:
+            _accept(t, hh, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws)
+            t = t_bound if last else t + hh
+            y[:] = ynew
+            f0[:] = K[12]
+            nfresh = np.int64(0)  # (typed int64, not a literal: one compiled signature per helper)
+            h = hh * factor
+            iout[IO_STEPS] += 1
+            b = _settle(y, model, pstate, count, plate_pair)
+            if b >= 0:
+                iout[IO_INDEX] = b
+                status = ST_SETTLE
+                break
+            continue
+        t_e = t + s * hh
+        if t_e <= t + 4.0 * EPS * abs(t) or s == 0.0:  # at the restart: apply there
+            status, nfresh = _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh,
+                                         f0)  # fmt: skip
+            if status >= 0:
+                break
+            continue
+        pend_k, pend_i, pend_t = k, i, t_e  # redo the step to end exactly at the event
+        h = t_e - t
+    if status == ST_START:
+        h = min(h, first_contact_step(y, model, iout[IO_INDEX], rtol))
+    tio[0] = t
+    tio[1] = h
+    iout[IO_STATUS] = status
+    iout[IO_ATTEMPTS] += attempts

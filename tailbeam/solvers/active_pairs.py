@@ -1,0 +1,228 @@
+"""Compiled (numba) pair physics of the active-set integrator: the IMPACT law region by region,
+pair kinematics, the right-hand side and the watched (event) functions.
+
+Plate frame (``tailbeam.physics.incline``): x downhill, z the plate normal, plate surface
+z = 0. State vector y (N,) = [x (n, 3) | v (n, 3)] flattened (m, m/s); a later block of extra
+states (the modal plate) goes after index 6 n. A pair p is (pi[p], pj[p]); pj = -1 is the
+plate, seen as a partner of radius 0 at the foot point (x, y, 0) (``tailbeam.physics.pair``):
+
+    ball-ball:  delta = r_i + r_j - |x_i - x_j|,  n = (x_i - x_j) / |x_i - x_j|
+    ball-plate: delta = r_i - z_i,                n = (0, 0, 1)
+    rate = -(v_i - v_j) . n  (> 0 approaching); force F n on i, -F n on j (frictionless).
+
+``law`` (P, 5) columns: stiffness k (N/m^e), exponent e, damping c (N s/m), penetration d (m),
+clamp (0/1), built by ``contact_law.ball_ball_law`` / ``ball_plate_law``. ``region_force``
+and ``clamp_indicator`` are the numba twins of ``contact_law.impact_force_in_region`` and
+``contact_law.clamp_indicator`` (tests/test_contact_law_regions.py checks them).
+
+Watched functions ("rows"), as in ``stream_reference._Reference.rows``: value g = sign x f +
+band, its event where g becomes negative:
+
+    R_CONTACT  f = |x_i - x_j|^2 - (r_i + r_j)^2 (plate: z^2 - r^2), sign + (start) / - (end)
+    R_FULL     f = |x_i - x_j|^2 - (r_i + r_j - d)^2, sign + in the ramp (delta -> d), else -
+    R_CLAMP    f = clamp indicator (not polynomial), sign + unclamped, - clamped
+    R_EDGE     f = edge distance of ball b (x + a/2, a/2 - x, y + b/2, b/2 - y), row 4 b + edge
+
+bands 1e-12 (r_i + r_j)^2 (contacts, full damping), 1e-10 (clamp), 1e-13 m (edges): a
+grazing touch does not start and end contacts over and over at round-off level.
+"""
+
+import math
+
+from tailbeam.solvers.jit import helper_njit
+
+L_K, L_E, L_C, L_D, L_CLAMP = range(5)
+R_CONTACT, R_FULL, R_CLAMP, R_EDGE = range(4)
+CLAMP_BAND = 1e-10
+EDGE_BAND = 1e-13
+
+
+@helper_njit
+def _pow(x, e):
+    """x^e for x >= 0; the Hertz exponent 3/2 as x sqrt(x)."""
+    if e == 1.5:
+        return x * math.sqrt(x)
+    return x**e
+
+
+@helper_njit
+def damping_in_region(delta, c, d, ramp):
+    """c STEP(delta, 0, 0, d, c) extended past [0, d] (ramp) or c (full damping), N s/m."""
+    if not ramp:
+        return c
+    s = delta / d
+    return c * s * s * (3.0 - 2.0 * s)
+
+
+@helper_njit
+def region_force(delta, rate, k, e, c, d, ramp, clamped):
+    """Force in N of one region's smooth formula (twin of impact_force_in_region)."""
+    if clamped:
+        return 0.0
+    pos = delta if delta > 0.0 else 0.0
+    return k * _pow(pos, e) + damping_in_region(pos, c, d, ramp) * rate
+
+
+@helper_njit
+def clamp_indicator(delta, rate, k, e, c, d, ramp):
+    """Raw force / (k delta^e) (twin of contact_law.clamp_indicator)."""
+    if delta > 0.0:
+        return 1.0 + damping_in_region(delta, c, d, ramp) * rate / (k * _pow(delta, e))
+    if ramp and e < 2.0:
+        return 1.0
+    if ramp and e == 2.0:
+        return 1.0 + 3.0 * c * rate / (k * d * d)
+    return -1.0 if rate < 0.0 else 1.0
+
+
+@helper_njit
+def elastic_energy(delta, k, e):
+    """k delta^(e+1) / (e+1) in J for delta > 0, else 0."""
+    if delta <= 0.0:
+        return 0.0
+    return k * _pow(delta, e) * delta / (e + 1.0)
+
+
+@helper_njit
+def pair_state(y, n, i, j, rsum):
+    """(delta, rate, nx, ny, nz) of the pair (i, j) at state y (j < 0: the plate)."""
+    xi = 3 * i
+    vi = 3 * n + 3 * i
+    if j < 0:
+        return rsum - y[xi + 2], -y[vi + 2], 0.0, 0.0, 1.0
+    xj = 3 * j
+    vj = 3 * n + 3 * j
+    dx = y[xi] - y[xj]
+    dy = y[xi + 1] - y[xj + 1]
+    dz = y[xi + 2] - y[xj + 2]
+    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+    nx, ny, nz = dx / dist, dy / dist, dz / dist
+    wn = (y[vi] - y[vj]) * nx + (y[vi + 1] - y[vj + 1]) * ny + (y[vi + 2] - y[vj + 2]) * nz
+    return rsum - dist, -wn, nx, ny, nz
+
+
+@helper_njit
+def pair_force(y, n, p, pi, pj, law, rsum, ramp, clamped):
+    """(F, delta, nx, ny, nz) of pair p in its region at state y."""
+    delta, rate, nx, ny, nz = pair_state(y, n, pi[p], pj[p], rsum[p])
+    f = region_force(
+        delta, rate, law[p, L_K], law[p, L_E], law[p, L_C], law[p, L_D], ramp[p], clamped[p]
+    )
+    return f, delta, nx, ny, nz
+
+
+@helper_njit
+def rhs_arrays(y, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, out):
+    """dy/dt of the active set: gravity on every present ball plus the touching pairs.
+    (Arrays passed one by one: unpacking the model tuple on every call costs more than the
+    right-hand side of a small set.)"""
+    n = mass.shape[0]
+    for b in range(n):
+        for k in range(3):
+            out[3 * b + k] = y[3 * n + 3 * b + k] if alive[b] else 0.0
+            out[3 * n + 3 * b + k] = g[k] if alive[b] else 0.0
+    for p in range(pi.shape[0]):
+        if not touching[p]:
+            continue
+        f, _, nx, ny, nz = pair_force(y, n, p, pi, pj, law, rsum, ramp, clamped)
+        if f == 0.0:
+            continue
+        i, j = pi[p], pj[p]
+        a = f / mass[i]
+        out[3 * n + 3 * i] += a * nx
+        out[3 * n + 3 * i + 1] += a * ny
+        out[3 * n + 3 * i + 2] += a * nz
+        if j >= 0:
+            a = f / mass[j]
+            out[3 * n + 3 * j] -= a * nx
+            out[3 * n + 3 * j + 1] -= a * ny
+            out[3 * n + 3 * j + 2] -= a * nz
+
+
+@helper_njit
+def rhs(y, model, pstate, out):
+    """``rhs_arrays`` with the model and pair-state tuples."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    rhs_arrays(y, mass, g, pi, pj, law, rsum, pstate[0], pstate[1], pstate[2], alive, out)
+
+
+@helper_njit
+def row_band(kind, idx, rsum):
+    """Dead band of a row (see the module docstring)."""
+    if kind == R_EDGE:
+        return EDGE_BAND
+    if kind == R_CLAMP:
+        return CLAMP_BAND
+    return 1e-12 * rsum[idx] * rsum[idx]
+
+
+@helper_njit
+def row_value_arrays(kind, idx, y, n, half, pi, pj, law, rsum, touching, ramp, clamped):
+    """g = sign x f + band of row (kind, idx) at state y: > 0 on the row's side."""
+    if kind == R_EDGE:
+        b, e = idx // 4, idx % 4
+        c = y[3 * b + e // 2]
+        h = half[e // 2]
+        f = c + h if e % 2 == 0 else h - c
+        return f + EDGE_BAND
+    i, j, rs = pi[idx], pj[idx], rsum[idx]
+    if kind == R_CLAMP:
+        delta, rate, _, _, _ = pair_state(y, n, i, j, rs)
+        ind = clamp_indicator(
+            delta, rate, law[idx, L_K], law[idx, L_E], law[idx, L_C], law[idx, L_D], ramp[idx]
+        )
+        return (-ind if clamped[idx] else ind) + CLAMP_BAND
+    if j < 0:
+        d2 = y[3 * i + 2] * y[3 * i + 2]
+    else:
+        dx = y[3 * i] - y[3 * j]
+        dy = y[3 * i + 1] - y[3 * j + 1]
+        dz = y[3 * i + 2] - y[3 * j + 2]
+        d2 = dx * dx + dy * dy + dz * dz
+    band = 1e-12 * rs * rs
+    if kind == R_CONTACT:
+        f = d2 - rs * rs
+        return (-f if touching[idx] else f) + band
+    r_full = rs - law[idx, L_D]
+    f = d2 - r_full * r_full
+    return (f if ramp[idx] else -f) + band
+
+
+@helper_njit
+def row_value(kind, idx, y, model, pstate):
+    """``row_value_arrays`` with the model and pair-state tuples."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
+    n = mass.shape[0]
+    return row_value_arrays(kind, idx, y, n, half, pi, pj, law, rsum, touching, ramp, clamped)
+
+
+@helper_njit
+def first_contact_step(y, model, p, rtol):
+    """First step after a contact start (s): where the tau^(e+2) term of the penetration
+    reaches rtol, t_s rtol^(1/(e+2)), and within half the ramp (as tailbeam.rigid)."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    n = mass.shape[0]
+    i, j = pi[p], pj[p]
+    m = mass[i] if j < 0 else mass[i] * mass[j] / (mass[i] + mass[j])
+    _, rate, _, _, _ = pair_state(y, n, i, j, rsum[p])
+    speed = max(rate, 1e-3)
+    k, e = law[p, L_K], law[p, L_E]
+    delta_m = ((e + 1.0) * m * speed * speed / (2.0 * k)) ** (1.0 / (e + 1.0))
+    return min(delta_m / speed * rtol ** (1.0 / (e + 2.0)), 0.5 * law[p, L_D] / speed)
+
+
+@helper_njit
+def settle_excess(y, model, p, b):
+    """Normal excess energy (J) of ball b on the plate pair p over its static state:
+    1/2 m vz^2 + U(delta) - U(delta_s) - m g_n (delta - delta_s), delta_s = (m g_n / k)^(1/e)."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    n = mass.shape[0]
+    m = mass[b]
+    k, e = law[p, L_K], law[p, L_E]
+    gn = -g[2]
+    delta = radius[b] - y[3 * b + 2]
+    vz = y[3 * n + 3 * b + 2]
+    delta_s = (m * gn / k) ** (1.0 / e) if gn > 0.0 else 0.0
+    u = elastic_energy(delta, k, e) - elastic_energy(delta_s, k, e)
+    return 0.5 * m * vz * vz + u - m * gn * (delta - delta_s)

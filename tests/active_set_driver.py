@@ -1,0 +1,117 @@
+"""A minimal driver for tests: every ball of a small scene in ONE active set, all pairs watched,
+restarted after every event; writes the same ContactRecord / LeaveEvent as the stream
+reference (not a test module; the fast solver's real driver is tailbeam/solvers/stream.py)."""
+
+import math
+
+import numpy as np
+
+from tailbeam.physics.incline import EDGES
+from tailbeam.physics.pair import pair_kinematics, plate_foot
+from tailbeam.solvers.active_set import ActiveSet
+from tailbeam.solvers.records import PLATE, ContactRecord, LeaveEvent
+
+
+def reference_pairs(n):
+    """Pairs in the order the reference creates them: (i, plate), then (min, max) with every
+    other ball."""
+    pairs = []
+    for i in range(n):
+        pairs.append((i, -1))
+        for j in range(n):
+            if j != i and (min(i, j), max(i, j)) not in pairs:
+                pairs.append((min(i, j), max(i, j)))
+    return pairs
+
+
+class SceneRun:
+    """Runs ``balls`` on ``incline`` for ``duration`` s; ``contacts``, ``leaves``, ``times``,
+    ``energy`` (J) and ``states`` (x, v, touching) at every return of ``advance`` (events and
+    every ``sample`` s)."""
+
+    def __init__(self, balls, incline, duration, *, sample=None, settle_energy=None, **kwargs):
+        self.balls, self.incline = balls, incline
+        self.names = [b.name for b in balls]
+        law_keys = ("damping", "penetration", "clamp", "exponent")
+        options = {k: kwargs.pop(k) for k in law_keys if k in kwargs}
+        pairs = reference_pairs(len(balls))
+        self.set = ActiveSet.from_balls(
+            balls, pairs, incline, settle_energy=settle_energy, **options, **kwargs
+        )
+        self.contacts, self.leaves, self.settled = [], [], []
+        self.open = {}
+        self.times, self.energy, self.returns, self.states = [], [], [], []
+        for p in np.flatnonzero(self.set.touching):
+            self.start(int(p), 0.0)
+        self.run(duration, sample or duration)
+
+    def kin(self, p):
+        s = self.set
+        i, j = int(s.pi[p]), int(s.pj[p])
+        xj = plate_foot(s.x[i][None]) if j < 0 else s.x[j][None]
+        vj = np.zeros((1, 3)) if j < 0 else s.v[j][None]
+        return i, j, pair_kinematics(s.x[i][None], s.v[i][None], xj, vj, [s.rsum[p]])
+
+    def start(self, p, t):
+        i, j, kin = self.kin(p)
+        n = kin.normal[0]
+        point = self.set.x[i] - n * (self.set.radius[i] - 0.5 * max(kin.penetration[0], 0.0))
+        rate = float(kin.rate[0])
+        partner = PLATE if j < 0 else self.names[j]
+        recs = [ContactRecord(self.names[i], partner, t, point[0], point[1],
+                              float(-self.set.v[i] @ n), rate)]  # fmt: skip
+        if j >= 0:
+            recs.append(ContactRecord(self.names[j], self.names[i], t, point[0], point[1],
+                                      float(self.set.v[j] @ n), rate))  # fmt: skip
+        self.contacts.extend(recs)
+        self.open[p] = recs
+
+    def end(self, p, t, how):
+        i, j, kin = self.kin(p)
+        n = kin.normal[0]
+        outs = [float(self.set.v[i] @ n)] + ([float(-self.set.v[j] @ n)] if j >= 0 else [])
+        for rec, v_out in zip(self.open.pop(p), outs, strict=True):
+            rec.t_end, rec.v_out, rec.approach_out, rec.end = t, v_out, -float(kin.rate[0]), how
+            self.finish(rec, p)
+
+    def finish(self, rec, p):
+        s = self.set
+        rec.peak_force, rec.t_peak, rec.max_penetration = s.peak[p], s.t_peak[p], s.pen[p]
+
+    def record(self, t):
+        s = self.set
+        m, alive = s.mass, s.alive
+        e = 0.5 * float(np.sum(m[alive, None] * s.v[alive] ** 2))
+        e -= float(np.sum(m[alive] * (s.x[alive] @ s.g)))
+        for p in np.flatnonzero(s.touching):
+            k, ex = s.law[p, 0], s.law[p, 1]
+            delta = s.penetration(p)[0]
+            e += k * max(delta, 0.0) ** (ex + 1.0) / (ex + 1.0)
+        self.times.append(t)
+        self.energy.append(e)
+        self.states.append((s.x.copy(), s.v.copy(), s.touching.copy()))
+
+    def run(self, duration, sample):
+        t = 0.0
+        self.record(t)
+        while t < duration:
+            out = self.set.advance(t, min(duration, (math.floor(t / sample + 1e-9) + 1) * sample))
+            t = out.t
+            self.returns.append(out)
+            if out.kind == "contact_start":
+                self.start(out.index, t)
+            elif out.kind == "contact_end":
+                self.end(out.index, t, "separated")
+            elif out.kind == "leave":
+                b = out.index
+                for p in [p for p in self.open if b in (self.set.pi[p], self.set.pj[p])]:
+                    self.end(p, t, "left")
+                self.leaves.append(LeaveEvent(self.names[b], t, EDGES[out.edge]))
+                self.set.remove_ball(b)
+            elif out.kind == "settle":
+                self.settled.append((self.names[out.index], t))
+                break
+            self.record(t)
+        for p, recs in self.open.items():
+            for rec in recs:
+                self.finish(rec, p)
