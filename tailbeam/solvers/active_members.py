@@ -173,10 +173,12 @@ class ActiveMembers:
     def positions(self, idx) -> np.ndarray:
         return np.array([self.state(int(i))[0] for i in idx]).reshape(-1, 3)
 
-    def energy(self) -> float:
-        """Kinetic energy of the members plus the elastic energy of their contacts (J)."""
+    def energy(self, balls) -> float:
+        """Kinetic energy of ``balls`` (members) plus the elastic energy of all contacts (J):
+        what a contact among them can give to one of them."""
         s = self._ready()
-        kinetic = 0.5 * float(np.sum(s.mass * np.sum(s.v * s.v, axis=1)))
+        q = [self.local[int(i)] for i in balls]
+        kinetic = 0.5 * float(np.sum(s.mass[q] * np.sum(s.v[q] * s.v[q], axis=1)))
         elastic = 0.0
         for p in np.flatnonzero(s.touching):
             delta, _ = s.penetration(p)

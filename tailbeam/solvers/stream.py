@@ -33,6 +33,7 @@ import numpy as np
 
 from tailbeam.contact_law import HERTZ_EXPONENT
 from tailbeam.errors import InputError, WorkLimitError, require_positive
+from tailbeam.hertz import hertz_contact_duration
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import quiet, task
 from tailbeam.solvers.broadphase import candidate_pairs
@@ -42,6 +43,8 @@ from tailbeam.solvers.stream_state import ACTIVE, FLY, GONE, SLIDE, Balls, LawOp
 DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
 SET_HORIZON = 1e-3  # s: the active set looks this far ahead for balls that could reach it
+RELEASE_RETRY = 1e-3  # s: a particle that would overlap a ball at its release waits this long
+REST_CONTACT_FACTOR = 50.0  # a plate contact longer than this many Hertz durations is at rest
 # heap event kinds (the order breaks ties at equal times: releases first)
 _RELEASE, _EPOCH, _PLATE, _PAIR, _EDGE = range(5)
 
@@ -108,9 +111,14 @@ class _Stream:
         self.core = set()
         self.contacts, self.leaves, self.events = [], [], []
         self.open = {}  # (i, j) -> [ContactRecord(s)] of the contacts in progress
+        self.limit = {}  # i -> time at which ball i's plate contact is declared at rest
         self.loads, self.dead_loads = [], []
         self.stats = dict.fromkeys(
-            ("heap_events", "stale", "set_events", "set_calls", "epochs", "late_starts"), 0
+            (
+                "heap_events", "stale", "set_events", "set_calls", "epochs", "late_starts",
+                "postponed_releases",
+            ),
+            0,
         )
         self.stats["rest_energy_removed"] = 0.0
         self.epoch = self._epoch_length()
@@ -139,9 +147,13 @@ class _Stream:
         for i, t in enumerate(self.balls.t_release):
             self.push(float(t), _RELEASE, i)
         self.push(0.0, _EPOCH)
-        shown = 0.0
+        shown, stuck, t_last = 0.0, 0, -1.0
         while True:
             self._check_work()
+            stuck = stuck + 1 if self.t == t_last else 0
+            t_last = self.t
+            if stuck > 100_000:
+                raise RuntimeError(f"stream solver: no progress at t = {self.t!r} s (a bug)")
             t_next = self.heap[0][0] if self.heap else math.inf
             target = min(t_next, self.duration)
             if self.act.members and self._advance_set(target):
@@ -210,11 +222,29 @@ class _Stream:
     # --- heap events --------------------------------------------------------------------------
     def _release(self, i: int):
         b = self.balls
+        if self._overlaps_at_release(i):
+            self.stats["postponed_releases"] += b.t_release[i] == b.particles[i].t_release
+            b.t_release[i] = self.t + RELEASE_RETRY
+            self.push(b.t_release[i], _RELEASE, i)
+            return
         b.set_motion(i, FLY, self.t, b.x0[i].copy(), b.v0[i].copy())
         self.events.append((self.t, EventKind.RELEASE, b.names[i], ""))
         self._predict(i)
         if self.act.members:
             self._refresh_set()
+
+    def _overlaps_at_release(self, i: int) -> bool:
+        """Does particle i, released now, overlap a ball already there (the generator
+        only knows the free flights of earlier particles, not their rebounds)?"""
+        b = self.balls
+        others = b.closed_form()
+        centres = b.states(others, self.t)[0] if len(others) else np.empty((0, 3))
+        core = [k for k in self.act.members if b.status[k] == ACTIVE]
+        if core:
+            centres = np.vstack([centres, self.act.positions(core)])
+            others = np.concatenate([others, np.array(core, dtype=np.int64)])
+        reach = b.radius[others] + b.radius[i]
+        return bool(np.any(np.sum((centres - b.x0[i]) ** 2, axis=1) < reach**2))
 
     def _new_epoch(self):
         """Certified candidate pairs of the closed-form balls over the next epoch."""
@@ -291,6 +321,8 @@ class _Stream:
 
     def _on_end(self, key):
         i, j = key
+        if key not in self.open:  # a pair the set found overlapping (counted in late_starts)
+            return
         if j >= 0:
             self._close(key, "separated")
             return
@@ -321,6 +353,13 @@ class _Stream:
         self.events.append((self.t, EventKind.LEAVE, b.names[i], edge))
 
     # --- membership -----------------------------------------------------------------------------
+    def _persistent_to_rest(self):
+        """Plate contacts older than their limit, with no other contact: at rest (their
+        normal oscillation is dropped: bounded work; the energy is counted)."""
+        for i, t_limit in list(self.limit.items()):
+            if t_limit <= self.t and self.act.touching_pairs(i) == [(i, -1)]:
+                self._on_settle(i)
+
     def _is_core(self, i: int) -> bool:
         return any(key in self.open for key in self.act.touching_pairs(i))
 
@@ -360,6 +399,7 @@ class _Stream:
         if depth > 1e-12:
             self.stats["late_starts"] += 1
 
+
     def _release_from_core(self, i: int):
         """Core ball i touches nothing any more (or only rests on the plate): closed form."""
         b = self.balls
@@ -384,6 +424,7 @@ class _Stream:
         """Core = members with a contact in progress; members = core + every closed-form
         ball that could reach a core ball within SET_HORIZON (certified bounds)."""
         b, t = self.balls, self.t
+        self._persistent_to_rest()
         for i in [i for i in self.core if not self._is_core(i)]:
             self._release_from_core(i)
         core = np.array(sorted(self.core), dtype=np.int64)
@@ -394,9 +435,13 @@ class _Stream:
             self.set_end = t
             return
         h = SET_HORIZON
-        self.set_end = t + h
+        self.set_end = min([t + h] + [self.limit[i] for i in core if i in self.limit])
         xc = self.act.positions(core)
-        sc = np.sqrt(2.0 * self.act.energy() / b.mass[core]) + np.linalg.norm(b.g) * h
+        # energy a core ball can receive: the core's kinetic and elastic energy, plus what
+        # gravity can give in h (a 1 cm drop of every core ball: far more than they fall)
+        g = np.linalg.norm(b.g)
+        energy = self.act.energy(core) + np.sum(b.mass[core]) * g * 0.01
+        sc = np.sqrt(2.0 * energy / b.mass[core]) + g * h
         if not len(cand):
             return
         x, _ = b.states(cand, t)
@@ -436,10 +481,20 @@ class _Stream:
             )
         self.act.reset_accumulators(key)
         self.open[key] = recs
+        if j < 0:
+            self.limit[i] = t + REST_CONTACT_FACTOR * self._hertz_duration(i, recs[0].v_in)
         self.contacts.extend(recs)
         self.events.append((t, EventKind.CONTACT_START, b.names[i], partner))
 
+    def _hertz_duration(self, i: int, speed: float) -> float:
+        """Hertz contact duration (s) of ball i on the plate at ``speed`` (>= rest_speed)."""
+        law = self.balls.plate_laws[i]
+        speed = max(speed, self.rest_speed, 1e-3)
+        return hertz_contact_duration(self.balls.mass[i], speed, law.stiffness, law.exponent)
+
     def _close(self, key, end: str):
+        if key[1] < 0:
+            self.limit.pop(key[0], None)
         n, _pen, _xi, vi, vj = self._normal(key)
         recs = self.open.pop(key)
         w = vi - (vj if vj is not None else 0.0)
