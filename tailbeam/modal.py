@@ -17,6 +17,7 @@ from tailbeam.errors import InputError
 
 PointEvaluator = Callable[[np.ndarray], np.ndarray]
 NAVIER_TERMS = 2000  # per direction
+NAVIER_CHUNK = 256  # points per matrix product of the Navier series
 ComplianceEvaluator = Callable[[np.ndarray, float], np.ndarray]
 DeflectionEvaluator = Callable[[np.ndarray, np.ndarray, float], np.ndarray]
 
@@ -161,16 +162,20 @@ def ssss_kirchhoff_basis(plate: Plate, fmax_hz: float) -> ModalBasis:
         y = points[:, 1:2] + 0.5 * b
         return amp * np.sin(m_idx * np.pi * x / a) * np.sin(n_idx * np.pi * y / b)
 
-    def navier(load_point, point):
-        # Navier series; terms fall like 1/(m^2 + n^2)^2, so the tail beyond N is O(1/N^2).
+    def navier(load_point, points):
+        # Navier series at points (p, 2); terms fall like 1/(m^2 + n^2)^2, so the tail beyond
+        # N is O(1/N^2). Summed as a matrix product, NAVIER_CHUNK points at a time.
         k = np.arange(1, NAVIER_TERMS + 1)
-        sx = np.sin(k * np.pi * (load_point[0] + 0.5 * a) / a)
-        sx = sx * np.sin(k * np.pi * (point[0] + 0.5 * a) / a)
-        sy = np.sin(k * np.pi * (load_point[1] + 0.5 * b) / b)
-        sy = sy * np.sin(k * np.pi * (point[1] + 0.5 * b) / b)
-        denom = (k[:, None] ** 2 / a**2 + k[None, :] ** 2 / b**2) ** 2
-        d_over = plate.bending_stiffness * np.pi**4
-        return 4.0 / (a * b * d_over) * np.sum(sx[:, None] * sy[None, :] / denom)
+        inv_denom = 1.0 / (k[:, None] ** 2 / a**2 + k[None, :] ** 2 / b**2) ** 2
+        lx = np.sin(k * np.pi * (load_point[0] + 0.5 * a) / a)
+        ly = np.sin(k * np.pi * (load_point[1] + 0.5 * b) / b)
+        out = np.empty(len(points))
+        for s in range(0, len(points), NAVIER_CHUNK):
+            chunk = points[s : s + NAVIER_CHUNK]
+            sx = np.sin(k * np.pi * (chunk[:, 0:1] + 0.5 * a) / a) * lx
+            sy = np.sin(k * np.pi * (chunk[:, 1:2] + 0.5 * b) / b) * ly
+            out[s : s + NAVIER_CHUNK] = np.sum(sx * (sy @ inv_denom.T), axis=1)
+        return 4.0 / (a * b * plate.bending_stiffness * np.pi**4) * out
 
     def point_load_only(contact_radius):
         if contact_radius != 0.0:
@@ -178,11 +183,13 @@ def ssss_kirchhoff_basis(plate: Plate, fmax_hz: float) -> ModalBasis:
 
     def static_compliance_at(points: np.ndarray, contact_radius: float = 0.0) -> np.ndarray:
         point_load_only(contact_radius)
-        return np.array([navier(p, p) for p in points])
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        return np.array([navier(p, p[None, :])[0] for p in points])
 
     def static_deflection_at(load_point, points, contact_radius: float = 0.0) -> np.ndarray:
         point_load_only(contact_radius)
-        return np.array([navier(load_point, p) for p in np.atleast_2d(points)])
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        return navier(np.asarray(load_point, dtype=float).reshape(2), points)
 
     return ModalBasis(
         plate=plate,

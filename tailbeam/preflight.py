@@ -24,7 +24,7 @@ Rules (and why):
 
 import math
 
-from tailbeam.errors import InputError
+from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.hertz import hertz_max_penetration
 
 MAX_PENETRATION_FRACTION = 0.1  # of the ball radius
@@ -42,27 +42,33 @@ def impact_speed(ball, gravity: float) -> float:
 def check_contacts(scene) -> None:
     """Penetration and damping rules (module docstring) for every ball of ``scene``."""
     for i, (ball, law) in enumerate(zip(scene.balls, scene.laws(), strict=True), start=1):
-        speed = impact_speed(ball, scene.gravity)
-        if speed > 0.0:
-            _check_penetration(i, ball, law, speed)
-        k_d = law.exponent * law.stiffness * law.penetration ** (law.exponent - 1.0)
-        ratio = law.damping / (2.0 * math.sqrt(k_d * ball.mass))
-        if ratio > MAX_CONTACT_DAMPING_RATIO:
-            limit = MAX_CONTACT_DAMPING_RATIO * 2.0 * math.sqrt(k_d * ball.mass)
-            raise InputError(
-                "contact.damping",
-                f"{law.damping:.3g} N s/m gives ball {ball.name!r} a contact damping ratio "
-                f"of {ratio:.3g}; it must be <= {MAX_CONTACT_DAMPING_RATIO:g} "
-                f"(c <= {limit:.3g} N s/m here; impacts end at rest from a ratio of ~300)",
-            )
+        check_ball_contact(ball, law, scene.gravity, f"balls[{i}].velocity")
 
 
-def _check_penetration(i, ball, law, speed) -> None:
+def check_ball_contact(ball, law, gravity: float, field: str) -> None:
+    """Penetration and damping rules for one ball with its ball-plate ``law``; ``field``
+    is named when its speed is to blame."""
+    speed = impact_speed(ball, gravity)
+    if speed > 0.0:
+        _check_penetration(field, ball, law, speed)
+    k_d = law.exponent * law.stiffness * law.penetration ** (law.exponent - 1.0)
+    ratio = law.damping / (2.0 * math.sqrt(k_d * ball.mass))
+    if ratio > MAX_CONTACT_DAMPING_RATIO:
+        limit = MAX_CONTACT_DAMPING_RATIO * 2.0 * math.sqrt(k_d * ball.mass)
+        raise InputError(
+            "contact.damping",
+            f"{law.damping:.3g} N s/m gives ball {ball.name!r} a contact damping ratio "
+            f"of {ratio:.3g}; it must be <= {MAX_CONTACT_DAMPING_RATIO:g} "
+            f"(c <= {limit:.3g} N s/m here; impacts end at rest from a ratio of ~300)",
+        )
+
+
+def _check_penetration(field, ball, law, speed) -> None:
     depth = hertz_max_penetration(ball.mass, speed, law.stiffness, law.exponent)
     allowed = MAX_PENETRATION_FRACTION * ball.radius
     if depth <= allowed:
         return
-    field = "contact.exponent" if law.exponent != 1.5 else f"balls[{i}].velocity"
+    field = "contact.exponent" if law.exponent != 1.5 else field
     raise InputError(
         field,
         f"ball {ball.name!r} would penetrate the plate by {depth:.3g} m at {speed:.3g} m/s "
@@ -75,7 +81,7 @@ def check_outputs(scene) -> None:
     """Size rules for timeseries.csv and the sensors (module docstring)."""
     rows = math.floor(scene.duration * scene.sample_rate) + 1
     values = rows * (1 + 3 * len(scene.balls))
-    if values > MAX_TIMESERIES_VALUES:
+    if values > MAX_TIMESERIES_VALUES and not scene.needs_stream_solver:  # (none for streams)
         raise InputError(
             "sample_rate",
             f"timeseries.csv would hold {rows:.3g} rows x {1 + 3 * len(scene.balls)} columns "
@@ -99,7 +105,47 @@ def check_outputs(scene) -> None:
             )
 
 
+def check_streams(scene) -> None:
+    """Rules for a scene the stream solver runs (streams, an inclined plate or balls that may
+    touch): the particle count the solver accepts, from the expected count before the
+    particles are generated and the actual count after; then the contact rules for every
+    stream particle (``streams[i].height`` or ``.velocity``, whichever gives more speed).
+    WorkLimitError names the setting to change."""
+    if not scene.needs_stream_solver:
+        return
+    from tailbeam.solvers.engine import stream_engine
+
+    engine = stream_engine()
+    _check_particle_count(scene, engine, sum(scene.expected_particles()), "expects")
+    _check_particle_count(scene, engine, len(scene.particles) - len(scene.balls), "has")
+    streams = {s.name: i for i, s in enumerate(scene.streams, start=1)}
+    g_n = scene.gravity * math.cos(math.radians(scene.inclination))
+    for p in scene.particles[len(scene.balls) :]:
+        ball = p.ball()
+        law = scene.contact.law_for(ball, scene.plate.material)
+        key = "velocity" if ball.velocity[2] ** 2 > 2.0 * g_n * ball.gap else "height"
+        check_ball_contact(ball, law, g_n, f"streams[{streams[p.stream]}].{key}")
+
+
+def _check_particle_count(scene, engine, from_streams: float, verb: str) -> None:
+    n = len(scene.balls) + from_streams
+    if engine.max_particles is None or n <= engine.max_particles:
+        return
+    if scene.streams:
+        expected = scene.expected_particles()
+        k = max(range(len(expected)), key=expected.__getitem__)
+        field = f"streams[{k + 1}].rate"
+    else:
+        field = "balls"
+    raise WorkLimitError(
+        f"{field}: the scene {verb} {n:.4g} particles; the {engine.name} accepts at most "
+        f"{engine.max_particles} (ball-ball contact, streams and inclined plates need the fast "
+        "stream solver beyond that): lower the rate, shorten the streams or the duration"
+    )
+
+
 def check_scene(scene) -> None:
-    """Every preflight rule; raises InputError on the first broken one."""
+    """Every preflight rule; raises InputError (or WorkLimitError) on the first broken one."""
     check_contacts(scene)
     check_outputs(scene)
+    check_streams(scene)

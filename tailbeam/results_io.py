@@ -11,32 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-# Column order of impacts.csv: the contract's first ten columns, then the rest.
-IMPACT_COLUMNS = (
-    "ball",
-    "index",
-    "t_start",
-    "t_end",
-    "v_in",
-    "v_out",
-    "restitution",
-    "peak_force",
-    "t_peak",
-    "max_penetration",
-    "next_apex_height",
-    "ends_at_rest",
-)
-IMPACT_UNITS = {
-    "t_start": "s",
-    "t_end": "s",
-    "v_in": "m/s",
-    "v_out": "m/s",
-    "restitution": "1",
-    "peak_force": "N",
-    "t_peak": "s",
-    "max_penetration": "m",
-    "next_apex_height": "m",
-}
+# Column order of impacts.csv (the contract's first ten columns, then the rest) and units.
+from tailbeam.solvers.stream_result import IMPACT_COLUMNS, IMPACT_UNITS  # noqa: F401
 
 
 def _cell(value) -> str:
@@ -64,6 +40,31 @@ def write_impacts_csv(path, impacts) -> Path:
 
     write_csv(path, IMPACT_COLUMNS, ([getattr(i, c) for c in IMPACT_COLUMNS] for i in impacts))
     return describe(path, units=IMPACT_UNITS)
+
+
+def write_table_csv(path, table: dict, units: dict) -> Path:
+    """A table of columns (name -> numpy array, in order) as CSV; units to the manifest."""
+    from tailbeam.output import describe
+
+    header = list(table)
+    write_csv(path, header, zip(*(table[c] for c in header), strict=True))
+    return describe(path, units={c: u for c, u in units.items() if c in table})
+
+
+def stream_summary(result, scene_echo: dict | None = None) -> dict:
+    """impacts.json of a stream scene: scene echo, units, impacts (rows of impacts.csv),
+    leave events, solver statistics and choices."""
+    from tailbeam.solvers.stream_result import STREAM_IMPACT_UNITS
+
+    table = result.impacts_table()
+    out = {} if scene_echo is None else {"scene": scene_echo}
+    out["units"] = STREAM_IMPACT_UNITS
+    rows = zip(*table.values(), strict=True)
+    out["impacts"] = [dict(zip(table, row, strict=True)) for row in rows]
+    out["leaves"] = [{"ball": e.ball, "time": e.time, "edge": e.edge} for e in result.leaves]
+    out["solver"] = {**result.stats, "status": result.status, "message": result.message}
+    out["automatic_choices"] = dict(result.info)
+    return out
 
 
 def _jsonable(value):

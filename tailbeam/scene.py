@@ -3,6 +3,8 @@
 Reading scene files lives in ``tailbeam.scene_file``; this module holds no I/O.
 """
 
+import functools
+import math
 from dataclasses import dataclass, field
 
 from tailbeam.bodies import STANDARD_GRAVITY, Ball, Plate
@@ -29,6 +31,7 @@ DEFAULT_DAMPING = 300.0  # c, N s/m
 DEFAULT_PENETRATION = 1e-4  # d, m (Adams' default 0.1 mm)
 
 PLATE_MODELS = ("rigid", "modal")
+LABELS = ("coal", "gangue")
 THEORIES = ("auto", "kirchhoff", "mindlin")
 COUPLINGS = ("two-way", "one-way")
 
@@ -152,10 +155,23 @@ class SensorSpec:
             )
 
 
+def default_label(ball: Ball) -> str:
+    """``coal`` for a ball of the material named coal, ``gangue`` otherwise."""
+    return "coal" if ball.material.name == "coal" else "gangue"
+
+
 @dataclass(frozen=True)
 class Scene:
-    """Everything that defines one simulation. duration in s, sample_rate (output) in Hz,
-    gravity in m/s^2 (along -z; 0 for none)."""
+    """Everything that defines one simulation.
+
+    duration in s, sample_rate (output) in Hz, gravity: its magnitude in m/s^2 (0 for none),
+    along -z of the horizontal plate; inclination: the plate's tilt in degrees, [0, 90), about
+    its y axis (x points downhill; positions and velocities are in the plate frame, gravity
+    there is g (sin theta, 0, -cos theta), tailbeam.physics.incline). streams: validated
+    stream settings (tailbeam.streams.generator.StreamSettings); their particles
+    (``particles``) are generated deterministically from the seeds when first asked for.
+    labels: ``coal`` or ``gangue`` per ball (default: ``default_label``).
+    """
 
     balls: tuple[Ball, ...]
     plate: Plate = field(default_factory=Plate)
@@ -166,27 +182,160 @@ class Scene:
     modal: ModalPlateSettings | None = None
     sensors: tuple[SensorSpec, ...] = ()
     gravity: float = STANDARD_GRAVITY
+    inclination: float = 0.0
+    streams: tuple = ()
+    labels: tuple[str, ...] = ()
 
     def __post_init__(self):
         require_positive("duration", self.duration)
         require_positive("sample_rate", self.sample_rate)
         object.__setattr__(self, "gravity", require_nonnegative("gravity", self.gravity))
+        object.__setattr__(self, "balls", tuple(self.balls))
+        object.__setattr__(self, "streams", tuple(self.streams))
+        object.__setattr__(self, "inclination", self.incline.inclination)  # validates it
         if self.plate_model not in PLATE_MODELS:
             raise InputError(
                 "plate.model", f"must be one of {PLATE_MODELS}, got {self.plate_model!r}"
             )
-        if not self.balls:
-            raise InputError("balls", "a scene needs at least one ball")
+        if not self.balls and not self.streams:
+            raise InputError("balls", "a scene needs at least one ball or stream")
         names = [b.name for b in self.balls]
         dup = {n for n in names if names.count(n) > 1}
         if dup:
             raise InputError("balls", f"ball names must be unique; repeated: {sorted(dup)}")
+        self._check_labels()
+        self._check_streams()
         sensor_names = [s.name for s in self.sensors]
         if len(set(sensor_names)) != len(sensor_names):
             raise InputError("sensors", "sensor names must be unique")
         if self.plate_model == "modal" and self.modal is None:
             object.__setattr__(self, "modal", ModalPlateSettings())
 
+    def _check_labels(self) -> None:
+        labels = tuple(self.labels) or tuple(default_label(b) for b in self.balls)
+        if len(labels) != len(self.balls):
+            raise InputError("labels", f"must give one label per ball ({len(self.balls)})")
+        for i, label in enumerate(labels, start=1):
+            if label not in LABELS:
+                raise InputError(f"balls[{i}].label", f"must be one of {LABELS}, got {label!r}")
+        object.__setattr__(self, "labels", labels)
+
+    def _check_streams(self) -> None:
+        names = {b.name for b in self.balls}
+        streams = [s.name for s in self.streams]
+        for i, s in enumerate(self.streams, start=1):
+            field_ = f"streams[{i}]"
+            if s.name in streams[: i - 1]:
+                raise InputError(f"{field_}.name", f"{s.name!r} is used by an earlier stream")
+            if s.start >= self.duration:
+                raise InputError(
+                    f"{field_}.start",
+                    f"must be < duration = {self.duration!r} s (nothing would be released), "
+                    f"got {s.start!r}",
+                )
+            prefix = f"{s.name}-"
+            clash = sorted(n for n in names if n.startswith(prefix) and n[len(prefix) :].isdigit())
+            if clash:
+                raise InputError(
+                    f"{field_}.name",
+                    f"its particles are named {s.name}-1, {s.name}-2, ...; a ball is already "
+                    f"called {clash[0]!r}",
+                )
+        if self.inclination != 0.0 and self.plate_model == "modal":
+            raise InputError(
+                "plate.inclination",
+                "an inclined modal plate: not yet (use plate.model = 'rigid' or inclination 0)",
+            )
+        if self.streams and self.plate_model == "modal":
+            raise InputError(
+                "streams", "streams on the modal plate: not yet (use plate.model = 'rigid')"
+            )
+
+    @property
+    def incline(self):
+        """The plate in its frame (tailbeam.physics.incline.InclinedPlate)."""
+        from tailbeam.physics.incline import InclinedPlate
+
+        return InclinedPlate(self.plate, self.inclination, self.gravity)
+
+    @functools.cached_property
+    def particles(self) -> tuple:
+        """Every body of the scene as a ``Particle`` (tailbeam.streams.generator): the balls
+        first (stream "", released at 0 s), then the streams' particles released before
+        ``duration``, in release order. Stream particles are generated on first use
+        (deterministic from the seeds)."""
+        from tailbeam.streams.generator import Particle, particles_from_settings
+
+        out = [
+            Particle(b.name, "", label, b.material, b.radius, b.mass, 0.0, b.position, b.velocity)
+            for b, label in zip(self.balls, self.labels, strict=True)
+        ]
+        if self.streams:
+            generated = particles_from_settings(self.streams, self.incline)
+            out += [p for p in generated if p.t_release < self.duration]
+        return tuple(out)
+
+    def expected_particles(self) -> list[float]:
+        """Expected particle count of each stream released before ``duration``:
+        rate x (min(stop, duration) - start)."""
+        return [s.rate * (min(s.stop, self.duration) - s.start) for s in self.streams]
+
     def laws(self) -> tuple[ImpactLaw, ...]:
         """The ball-plate law of each ball, in ball order."""
         return tuple(self.contact.law_for(b, self.plate.material) for b in self.balls)
+
+    def first_ball_contact(self):
+        """(j, i, t): the first pair of balls (0-based, i < j) whose horizontal paths (uniform
+        lateral motion, exact on a horizontal frictionless plate) come within the sum of their
+        radii at t <= duration s, or None when no two balls can touch."""
+        for j, b in enumerate(self.balls):
+            for i, a in enumerate(self.balls[:j]):
+                dx = b.position[0] - a.position[0]
+                dy = b.position[1] - a.position[1]
+                ux = b.velocity[0] - a.velocity[0]
+                uy = b.velocity[1] - a.velocity[1]
+                t = _first_approach(dx, dy, ux, uy, a.radius + b.radius, self.duration)
+                if t is not None:
+                    return j, i, t
+        return None
+
+    @functools.cached_property
+    def needs_stream_solver(self) -> bool:
+        """A rigid plate with streams, an inclination or balls that may touch each other:
+        the stream solver (tailbeam.simulation); otherwise the single-ball solvers are exact
+        and used (the modal plate refuses such scenes for now)."""
+        if self.plate_model != "rigid":
+            return False
+        return bool(self.streams) or self.inclination != 0.0 or bool(self.first_ball_contact())
+
+
+def check_no_ball_contact(balls, duration: float) -> None:
+    """On the modal plate ball-ball contact is not modelled yet: refuse (InputError naming
+    ``balls[j].position``) two balls whose horizontal paths come within the sum of their
+    radii by ``duration`` s. (The rigid plate runs such scenes with the stream solver.)"""
+    found = Scene(balls, duration=duration).first_ball_contact() if len(balls) > 1 else None
+    if found is None:
+        return
+    j, i, t = found
+    a, b = balls[i], balls[j]
+    raise InputError(
+        f"balls[{j + 1}].position",
+        f"ball {b.name!r} comes closer (horizontally) than the sum of the radii, "
+        f"{a.radius + b.radius:.4g} m, to ball {a.name!r} at t = {t:.4g} s, so they could "
+        "touch; ball-ball contact on the modal plate is not modelled yet (plate.model = "
+        "'rigid' runs it)",
+    )
+
+
+def _first_approach(dx, dy, ux, uy, reach, duration):
+    """First t in [0, duration] with |(dx, dy) + (ux, uy) t| <= reach (None if never)."""
+    c = dx * dx + dy * dy - reach * reach
+    if c < 0.0:
+        return 0.0
+    a = ux * ux + uy * uy
+    b = dx * ux + dy * uy
+    disc = b * b - a * c
+    if a == 0.0 or b >= 0.0 or disc < 0.0:
+        return None  # not approaching, or passing wide
+    t = (-b - math.sqrt(disc)) / a
+    return t if t <= duration else None

@@ -7,7 +7,7 @@ sweep's provenance); ``dumps_scene`` its TOML text, with ``loads_scene(dumps_sce
 import math
 
 from tailbeam.materials import BUILTIN_MATERIALS
-from tailbeam.scene import Scene
+from tailbeam.scene import Scene, default_label
 
 MATERIAL_KEYS = ("density", "youngs_modulus", "poisson_ratio")
 
@@ -21,6 +21,8 @@ def scene_to_dict(scene: Scene) -> dict:
         "material": p.material.name,
         "size": [p.size_x, p.size_y, p.thickness],
     }
+    if scene.inclination != 0.0:  # written only when set: earlier scenes echo as before
+        plate["inclination"] = scene.inclination
     if scene.plate_model == "modal" and scene.modal is not None:
         m = scene.modal
         plate.update(
@@ -37,6 +39,7 @@ def scene_to_dict(scene: Scene) -> dict:
         if m.mesh_divisions is not None:
             plate["mesh_divisions"] = m.mesh_divisions
     used = {b.material for b in scene.balls} | {p.material}
+    used |= {m for s in scene.streams for m in (s.coal_material, s.gangue_material)}
     materials = {
         m.name: {k: getattr(m, k) for k in MATERIAL_KEYS}
         for m in sorted(used, key=lambda m: m.name)
@@ -52,16 +55,7 @@ def scene_to_dict(scene: Scene) -> dict:
     out["plate"] = plate
     if materials:
         out["materials"] = materials
-    out["balls"] = [
-        {
-            "name": b.name,
-            "material": b.material.name,
-            "radius": b.radius,
-            "position": list(b.position),
-            "velocity": list(b.velocity),
-        }
-        for b in scene.balls
-    ]
+    out["balls"] = [_ball(b, label) for b, label in zip(scene.balls, scene.labels, strict=True)]
     sensors = []
     for s in scene.sensors:
         d = {"name": s.name, "position": list(s.position), "sample_rate": s.sample_rate}
@@ -76,7 +70,45 @@ def scene_to_dict(scene: Scene) -> dict:
         sensors.append(d)
     if sensors:
         out["sensors"] = sensors
+    if scene.streams:
+        out["streams"] = [stream_to_dict(s) for s in scene.streams]
     return out
+
+
+def _ball(ball, label: str) -> dict:
+    d = {
+        "name": ball.name,
+        "material": ball.material.name,
+        "radius": ball.radius,
+        "position": list(ball.position),
+        "velocity": list(ball.velocity),
+    }
+    if label != default_label(ball):  # written only when not the default
+        d["label"] = label
+    return d
+
+
+def stream_to_dict(s) -> dict:
+    """The ``[[streams]]`` keys of validated settings (tailbeam.streams.generator)."""
+    from tailbeam.streams.generator import DISTRIBUTIONS
+
+    d = {
+        "name": s.name,
+        "rate": s.rate,
+        "start": s.start,
+        "stop": s.stop,
+        "gangue_fraction": s.gangue_fraction,
+        "coal_material": s.coal_material.name,
+        "gangue_material": s.gangue_material.name,
+        "radius": list(s.radius),
+        "size_distribution": s.size_distribution,
+    }
+    d.update(zip(DISTRIBUTIONS[s.size_distribution], s.size_parameters, strict=True))
+    d["area"] = [list(s.area[0]), list(s.area[1])]
+    d["height"] = s.height[0] if s.height[0] == s.height[1] else list(s.height)
+    d.update(velocity=list(s.velocity), velocity_spread=s.velocity_spread, seed=s.seed)
+    d["max_tries"] = s.max_tries
+    return d
 
 
 def _toml_value(v) -> str:
@@ -101,7 +133,7 @@ def dumps_scene(scene: Scene) -> str:
         lines += ["", f"[{section}]"] + [f"{k} = {_toml_value(v)}" for k, v in d[section].items()]
     for name, props in d.get("materials", {}).items():
         lines += ["", f"[materials.{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in props.items()]
-    for array in ("balls", "sensors"):
+    for array in ("balls", "sensors", "streams"):
         for entry in d.get(array, []):
             lines += ["", f"[[{array}]]"] + [f"{k} = {_toml_value(v)}" for k, v in entry.items()]
     return "\n".join(lines) + "\n"

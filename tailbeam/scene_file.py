@@ -7,7 +7,6 @@ Omitted optional keys take the defaults of ``tailbeam.scene``.
 """
 
 import difflib
-import math
 import re
 import sys
 from pathlib import Path
@@ -22,8 +21,17 @@ from tailbeam.errors import (
 )
 from tailbeam.materials import Material, get_material
 from tailbeam.noise import NoiseSpec
+from tailbeam.physics.incline import InclinedPlate
 from tailbeam.preflight import check_scene
-from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene, SensorSpec
+from tailbeam.scene import (
+    LABELS,
+    ContactSettings,
+    ModalPlateSettings,
+    Scene,
+    SensorSpec,
+    check_no_ball_contact,
+    default_label,
+)
 
 # writing back lives in tailbeam.scene_dump; re-exported so existing imports keep working
 from tailbeam.scene_dump import MATERIAL_KEYS, dumps_scene, scene_to_dict  # noqa: F401
@@ -42,10 +50,11 @@ TOP_KEYS = (
     "materials",
     "balls",
     "sensors",
+    "streams",
 )
 SENSOR_NAME = re.compile(r"[A-Za-z0-9_.+-]+")  # used in file names (sensor_<name>.png)
 CONTACT_KEYS = ("exponent", "damping", "penetration", "clamp")
-PLATE_KEYS = ("model", "material", "size")
+PLATE_KEYS = ("model", "material", "size", "inclination")
 MODAL_KEYS = (
     "boundary",
     "theory",
@@ -56,9 +65,10 @@ MODAL_KEYS = (
     "residual_flexibility",
     "coupling",
 )
-BALL_KEYS = ("name", "material", "radius", "position", "velocity")
+BALL_KEYS = ("name", "material", "radius", "position", "velocity", "label")
 SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance", "noise")
 NOISE_KEYS = ("rms", "background", "band", "seed")
+REQUIRED = ("duration", "balls")  # or duration and streams
 
 
 def load_scene(path) -> Scene:
@@ -87,28 +97,36 @@ def loads_scene(text: str, *, source: str = "scene") -> Scene:
 
 def parse_scene(data: dict) -> Scene:
     """Build a Scene from the parsed TOML table ``data``."""
-    _check_keys("", data, TOP_KEYS, required=("duration", "balls"))
+    _check_keys("", data, TOP_KEYS, required=("duration",) if "streams" in data else REQUIRED)
     materials = _parse_materials(data.get("materials", {}))
     contact = _parse_contact(_table("contact", data.get("contact", {})))
     plate, model, modal = _parse_plate(_table("plate", data.get("plate", {})), materials)
-    balls = _parse_balls(data["balls"], materials, plate)
-    _check_ball_paths(balls, require_positive("duration", data["duration"]))
+    kwargs = {}
+    if "inclination" in _table("plate", data.get("plate", {})):
+        kwargs["inclination"] = data["plate"]["inclination"]
+    if "gravity" in data:
+        kwargs["gravity"] = require_nonnegative("gravity", data["gravity"])
+    incline = InclinedPlate(plate, **kwargs)  # validates plate.inclination
+    duration = require_positive("duration", data["duration"])
+    balls, labels = _parse_balls(data.get("balls", []), materials, plate, "streams" in data)
+    if model == "modal":
+        check_no_ball_contact(balls, duration)
+    streams = _parse_streams(data.get("streams", []), incline, materials)
     sensors = _parse_sensors(data.get("sensors", []), plate)
     if sensors and model != "modal":
         raise InputError("sensors", "need plate.model = 'modal' (a rigid plate does not vibrate)")
-    kwargs = {}
     if "sample_rate" in data:
         kwargs["sample_rate"] = require_positive("sample_rate", data["sample_rate"])
-    if "gravity" in data:
-        kwargs["gravity"] = require_nonnegative("gravity", data["gravity"])
     scene = Scene(
         balls,
         plate,
         contact,
-        require_positive("duration", data["duration"]),
+        duration,
         plate_model=model,
         modal=modal,
         sensors=sensors,
+        streams=streams,
+        labels=labels,
         **kwargs,
     )
     check_scene(scene)
@@ -227,11 +245,12 @@ def _parse_plate(table: dict, materials: dict):
     return plate, model, modal
 
 
-def _parse_balls(value, materials: dict, plate: Plate) -> tuple:
+def _parse_balls(value, materials: dict, plate: Plate, has_streams: bool) -> tuple:
+    """The balls and their labels (``label`` or the default of tailbeam.scene)."""
     tables = _array_of_tables("balls", value)
-    if not tables:
+    if not tables and not has_streams:
         raise InputError("balls", "a scene needs at least one [[balls]] entry")
-    balls = []
+    balls, labels = [], []
     for i, t in enumerate(tables, start=1):
         field = f"balls[{i}]"
         _check_keys(field, t, BALL_KEYS, required=("name", "material", "radius", "position"))
@@ -254,41 +273,22 @@ def _parse_balls(value, materials: dict, plate: Plate) -> tuple:
                 f"plate, |x| <= {plate.size_x / 2!r}, |y| <= {plate.size_y / 2!r}",
             )
         balls.append(ball)
-    return tuple(balls)
+        labels.append(default_label(ball))
+        if "label" in t:
+            labels[-1] = _string(f"{field}.label", t["label"])
+            if labels[-1] not in LABELS:
+                raise InputError(f"{field}.label", f"must be one of {LABELS}, got {labels[-1]!r}")
+    return tuple(balls), tuple(labels)
 
 
-def _check_ball_paths(balls, duration: float) -> None:
-    """Ball-ball contact is not modelled: the horizontal paths (uniform lateral motion) of any two
-    balls must stay at least r1 + r2 apart during the simulation, else they could touch."""
-    for j, b in enumerate(balls):
-        for a in balls[:j]:
-            dx = b.position[0] - a.position[0]
-            dy = b.position[1] - a.position[1]
-            ux = b.velocity[0] - a.velocity[0]
-            uy = b.velocity[1] - a.velocity[1]
-            reach = a.radius + b.radius
-            t = _first_approach(dx, dy, ux, uy, reach, duration)
-            if t is not None:
-                raise InputError(
-                    f"balls[{j + 1}].position",
-                    f"ball {b.name!r} comes closer (horizontally) than the sum of the radii, "
-                    f"{reach:.4g} m, to ball {a.name!r} at t = {t:.4g} s, so they could touch; "
-                    "ball-ball contact is not modelled",
-                )
+def _parse_streams(value, incline: InclinedPlate, materials: dict) -> tuple:
+    """Validated ``[[streams]]`` settings (tailbeam.streams.generator.parse_stream)."""
+    tables = _array_of_tables("streams", value)
+    if not tables:
+        return ()
+    from tailbeam.streams.generator import parse_stream  # scipy.special: only for streams
 
-
-def _first_approach(dx, dy, ux, uy, reach, duration):
-    """First t in [0, duration] with |(dx, dy) + (ux, uy) t| <= reach (None if never)."""
-    c = dx * dx + dy * dy - reach * reach
-    if c < 0.0:
-        return 0.0
-    a = ux * ux + uy * uy
-    b = dx * ux + dy * uy
-    disc = b * b - a * c
-    if a == 0.0 or b >= 0.0 or disc < 0.0:
-        return None  # not approaching, or passing wide
-    t = (-b - math.sqrt(disc)) / a
-    return t if t <= duration else None
+    return tuple(parse_stream(t, i, incline, materials) for i, t in enumerate(tables, start=1))
 
 
 def _parse_sensors(value, plate: Plate) -> tuple:

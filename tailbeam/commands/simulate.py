@@ -2,9 +2,13 @@
 
 Writes impacts.csv, impacts.json, timeseries.csv (uniform grid) and manifest.json into DIR;
 for a modal plate also sensors.csv, sensor_spectra.csv and one sensor_<name>.png (time and
-spectrum) per sensor. Bad input is reported as one line on stderr with exit code 2, and
-nothing is written: the scene and --out are fully validated before the solver runs, and the
-results replace DIR whole (tailbeam.output), so DIR never mixes two runs.
+spectrum) per sensor. A scene the stream solver runs (streams, an inclined plate, balls that
+may touch) writes impacts.csv with the stream columns, particles.csv, impacts.json and
+manifest.json (tailbeam.solvers.stream_result).
+
+Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
+scene and --out are fully validated before the solver runs, and the results replace DIR
+whole (tailbeam.output), so DIR never mixes two runs.
 """
 
 from tailbeam.cachedir import announce_first_compile
@@ -21,19 +25,10 @@ def add_arguments(parser):
 
 
 def solve(scene):
-    """Run the scene's solver: rigid plate -> simulate_rigid, modal plate -> the coupled model."""
-    if scene.plate_model == "rigid":
-        from tailbeam.rigid import simulate_rigid
+    """Run the scene's solver (``tailbeam.simulate`` chooses it from the scene)."""
+    from tailbeam import simulate
 
-        with task(f"simulating {scene.duration:g} s, {len(scene.balls)} balls, rigid plate"):
-            return simulate_rigid(
-                scene.balls, scene.plate, scene.laws(), scene.duration, gravity=scene.gravity
-            )
-    from tailbeam.coupled import simulate_scene_modal
-
-    # The modal path chooses its band from the scene (contact durations, sensor bandwidths),
-    # the theory from the band, and records both choices in result.info.
-    return simulate_scene_modal(scene)
+    return simulate(scene)
 
 
 def _choices(result) -> dict:
@@ -44,6 +39,8 @@ def _choices(result) -> dict:
 
 def write_results(out_dir, scene, result) -> list:
     """Write every output file of ``result`` into ``out_dir`` (an existing directory)."""
+    if hasattr(result, "particles_table"):
+        return write_stream_results(out_dir, scene, result)
     from tailbeam.results_io import (
         result_summary,
         write_impacts_csv,
@@ -66,6 +63,20 @@ def write_results(out_dir, scene, result) -> list:
             bar.update(1)
             files += _write_sensors(out_dir, scene, result, outputs, bar)
     return files
+
+
+def write_stream_results(out_dir, scene, result) -> list:
+    """impacts.csv (stream columns), particles.csv and impacts.json of a stream scene (no
+    timeseries.csv: the stream solvers keep no states, tailbeam.solvers.stream_result)."""
+    from tailbeam.results_io import stream_summary, write_json, write_table_csv
+    from tailbeam.scene_file import scene_to_dict
+    from tailbeam.solvers.stream_result import PARTICLE_UNITS, STREAM_IMPACT_UNITS
+
+    return [
+        write_table_csv(out_dir / "impacts.csv", result.impacts_table(), STREAM_IMPACT_UNITS),
+        write_table_csv(out_dir / "particles.csv", result.particles_table(), PARTICLE_UNITS),
+        write_json(out_dir / "impacts.json", stream_summary(result, scene_to_dict(scene))),
+    ]
 
 
 def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
@@ -104,7 +115,8 @@ def run(args) -> int:
 
     check_output_dir(args.out)
     scene = load_scene(args.scene)
-    announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
+    if not scene.needs_stream_solver:
+        announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
     result = solve(scene)
     with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:
         files = write_results(tmp, scene, result)

@@ -135,6 +135,7 @@ def simulate_stream_reference(
     rtol: float = 1e-12,
     max_steps: int = 200_000,
     release_times=None,
+    progress=None,
 ) -> StreamReferenceResult:
     """Integrate ``balls`` (``tailbeam.Ball``, positions and velocities in the plate frame)
     on ``incline`` for ``duration`` s; see the module docstring.
@@ -144,6 +145,7 @@ def simulate_stream_reference(
     positions, rtol x 1 m/s on velocities). max_steps bounds the work (WorkLimitError).
     release_times (s, one per ball, default all 0): a ball enters the scene at its time, at
     its given position and velocity (event ``release``; the energy series jumps there).
+    progress: optional callable, called with the time (s) reached after every accepted step.
     """
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-3:
@@ -152,6 +154,7 @@ def simulate_stream_reference(
     balls = list(balls)
     release = _release_times(release_times, len(balls))
     sim = _Reference(balls, incline, options, rtol, max_steps, release)
+    sim.progress = progress
     return sim.run(duration)
 
 
@@ -170,6 +173,7 @@ class _Reference:
         self.contacts, self.leaves, self.events = [], [], []
         self.times, self.energy, self.states = [], [], []
         self.steps = 0
+        self.progress = None
         pos = np.array([balls[i].position for i in self.active], dtype=float).reshape(-1, 3)
         vel = np.array([balls[i].velocity for i in self.active], dtype=float).reshape(-1, 3)
         self.y = np.concatenate([pos.ravel(), vel.ravel()])
@@ -265,6 +269,8 @@ class _Reference:
             if found is None:
                 self.accept(dense, t0, t1)
                 self.record_step(t1, solver.y)
+                if self.progress is not None:
+                    self.progress(t1)
                 fresh = set() if t1 > t0 else fresh
                 continue
             row, t_e = found

@@ -300,6 +300,11 @@ def generate_particles(streams, incline: InclinedPlate, materials=None) -> list:
     """Particles of all ``streams`` (a list of settings mappings, ``streams[1]`` first),
     in release order (ties: stream order, then k). See the module docstring."""
     parsed = [parse_stream(s, i, incline, materials) for i, s in enumerate(streams, start=1)]
+    return particles_from_settings(parsed, incline)
+
+
+def particles_from_settings(parsed, incline: InclinedPlate) -> list:
+    """``generate_particles`` for streams already validated by ``parse_stream``."""
     names = [p.name for p in parsed]
     for i, name in enumerate(names):
         if name in names[:i]:
