@@ -236,6 +236,10 @@ class ActiveMembers:
             s = self._ready()
             s.settle_energy[self.local[i]] = self.settle_energy(i)
 
+    def steps(self) -> int:
+        """Kernel steps so far (accepted)."""
+        return self.totals["kernel_steps"] + (self.set.stats["steps"] if self.set else 0)
+
     def stats(self) -> dict:
         self._count()
         return dict(self.totals)

@@ -27,7 +27,7 @@ import contextlib
 import heapq
 import math
 import time as _time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -42,6 +42,7 @@ from tailbeam.solvers.stream_state import ACTIVE, FLY, GONE, SLIDE, Balls, LawOp
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
+DEFAULT_MAX_STEPS = 50_000_000  # kernel steps + events: the work bound
 SET_HORIZON = 1e-3  # s: the active set looks this far ahead for balls that could reach it
 RELEASE_RETRY = 1e-3  # s: a particle that would overlap a ball at its release waits this long
 REST_CONTACT_FACTOR = 50.0  # a plate contact longer than this many Hertz durations is at rest
@@ -53,6 +54,7 @@ _RELEASE, _EPOCH, _PLATE, _PAIR, _EDGE = range(5)
 class StreamRun:
     """What the stream solver found (``tailbeam.solvers.stream_result`` presents it)."""
 
+    particles: list  # as released (a release onto a rebounding ball is postponed)
     contacts: list
     leaves: list
     events: list
@@ -64,6 +66,38 @@ class StreamRun:
 
 
 def simulate_stream(
+    particles, incline: InclinedPlate, duration: float, *, laws, rtol: float = DEFAULT_RTOL,
+    max_steps: int = DEFAULT_MAX_STEPS, progress=True, rest_speed: float = DEFAULT_REST_SPEED,
+):  # fmt: skip
+    """The stream solver as ``tailbeam.solvers.engine`` calls it: a ``StreamResult``.
+
+    laws: the IMPACT settings shared by every pair (``tailbeam.scene.ContactSettings``:
+    exponent, damping, penetration, clamp). progress: True (a bar), False, or a callable
+    taking the simulated time reached (s)."""
+    from tailbeam.solvers.stream_result import StreamResult
+
+    run = solve_stream(
+        particles, incline, duration, damping=laws.damping, penetration=laws.penetration,
+        clamp=laws.clamp, exponent=laws.exponent, rtol=rtol, rest_speed=rest_speed,
+        max_work=max_steps, progress=progress,
+    )  # fmt: skip
+    result = StreamResult(
+        run.particles, run.contacts, run.leaves, run.events, incline, duration,
+        status=run.status, message=run.message, stats=run.stats,
+        info={"solver": "fast stream solver (event-driven, active-set DOP853)"},
+    )  # fmt: skip
+    result.loads = (run.loads, run.dead_loads)
+    return result
+
+
+def estimate(n_particles: int, max_steps: int) -> tuple[float, float]:
+    """Upper-bound-style estimates (bytes, s) for ``tailbeam.simulation``'s preflight: per
+    particle ~30 contact records and force histories (~40 kB), and the measured ~5 ms of
+    wall time per particle of the reference stream (benchmarks/bench_stream.py) x 4."""
+    return 4e4 * n_particles + 5e7, 2e-2 * n_particles
+
+
+def solve_stream(
     particles,
     incline: InclinedPlate,
     duration: float,
@@ -74,26 +108,41 @@ def simulate_stream(
     exponent: float = HERTZ_EXPONENT,
     rtol: float = DEFAULT_RTOL,
     rest_speed: float = DEFAULT_REST_SPEED,
-    max_events: int = 20_000_000,
-    progress: bool = True,
+    max_work: int = DEFAULT_MAX_STEPS,
+    progress=True,
 ) -> StreamRun:
     """Simulate ``particles`` (``tailbeam.streams.generator.Particle``: released at their
     t_release with their position and velocity, plate frame) on ``incline`` for ``duration``
     s. IMPACT parameters shared by every pair (stiffness from Hertz for each pair); rtol: the
-    kernel's relative tolerance; rest_speed (m/s): see the module docstring."""
+    kernel's relative tolerance; rest_speed (m/s): see the module docstring; max_work: bound
+    on kernel steps plus events (WorkLimitError beyond)."""
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-4:
         raise InputError("rtol", f"must lie in [1e-14, 1e-4], got {rtol!r}")
     if rest_speed < 0:
         raise InputError("rest_speed", f"must be >= 0, got {rest_speed!r}")
     options = LawOptions(exponent, damping, penetration, clamp)
-    sim = _Stream(particles, incline, duration, options, rtol, rest_speed, max_events)
-    label = f"simulating {duration:g} s, {len(sim.balls.names)} particles, rigid plate"
+    sim = _Stream(particles, incline, duration, options, rtol, rest_speed, max_work)
+    label = f"simulating {duration:g} s, {len(sim.balls.names)} particles"
     with contextlib.ExitStack() as stack:
-        if not progress:
-            stack.enter_context(quiet())
-        bar = stack.enter_context(task(label, total=1e3 * duration, unit="ms simulated"))
+        if callable(progress):
+            bar = _CallbackBar(progress)
+        else:
+            if not progress:
+                stack.enter_context(quiet())
+            bar = stack.enter_context(task(label, total=1e3 * duration, unit="ms simulated"))
         return sim.run(bar)
+
+
+class _CallbackBar:
+    """A progress 'bar' that reports the simulated time reached (s) to a callable."""
+
+    def __init__(self, report):
+        self.report, self.ms = report, 0.0
+
+    def update(self, ms):
+        self.ms += ms
+        self.report(self.ms / 1e3)
 
 
 class _Stream:
@@ -106,7 +155,7 @@ class _Stream:
         self.incline, self.duration, self.options = incline, duration, options
         self.rest_speed, self.max_events = rest_speed, max_events
         self.act = ActiveMembers(self.balls, options, rtol, self._settle_energy)
-        self.heap, self.seq, self.t = [], 0, 0.0
+        self.heap, self.seq, self.t, self.loops = [], 0, 0.0, 0
         self.epoch_end, self.set_end = 0.0, 0.0
         self.core = set()
         self.contacts, self.leaves, self.events = [], [], []
@@ -169,12 +218,23 @@ class _Stream:
         return self._finish(_time.perf_counter() - wall)
 
     def _check_work(self):
-        n = self.stats["heap_events"] + self.stats["set_events"]
+        self.loops += 1
+        if self.loops % 256:
+            return
+        n = self.stats["heap_events"] + self.stats["set_events"] + self.act.steps()
         if n > self.max_events:
             raise WorkLimitError(
-                f"more than max_events={self.max_events} events by t = {self.t:.6g} s; "
-                "raise max_events, shorten duration or lower the stream rates"
+                f"max_steps: more than {self.max_events} steps and events by t = {self.t:.6g}"
+                " s; raise max_steps, shorten duration or lower the stream rates"
             )
+
+    def _released(self) -> list:
+        """The particles with their actual release times."""
+        b = self.balls
+        return [
+            p if b.t_release[q] == p.t_release else replace(p, t_release=float(b.t_release[q]))
+            for q, p in enumerate(b.particles)
+        ]
 
     def _advance_set(self, target: float) -> bool:
         """Advance the active set towards ``target``; True if it stopped earlier (an event
@@ -546,6 +606,6 @@ class _Stream:
         self.stats["wall_s"] = wall
         self.stats["contacts"] = len(self.contacts)
         return StreamRun(
-            self.contacts, self.leaves, self.events, self.loads, self.dead_loads, 0,
-            "reached the end of the simulated time", self.stats,
+            self._released(), self.contacts, self.leaves, self.events, self.loads,
+            self.dead_loads, 0, "reached the end of the simulated time", self.stats,
         )  # fmt: skip
