@@ -66,6 +66,7 @@ def _rigid(scene, how):
 
 def _modal(scene, how):
     from tailbeam.coupled import simulate_scene_modal
+
     if how:
         raise InputError(next(iter(how)), "is not a setting of the modal plate solver")
     # The modal path chooses its band from the scene (contact durations, sensor bandwidths),

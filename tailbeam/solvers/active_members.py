@@ -186,6 +186,19 @@ class ActiveMembers:
             elastic += k * max(delta, 0.0) ** (e + 1.0) / (e + 1.0)
         return kinetic + elastic
 
+    def elastic_energy_of(self, i: int) -> float:
+        """Elastic energy (J) of member i's touching plate pair plus half of each of its
+        touching ball-ball pairs."""
+        s = self._ready()
+        total = 0.0
+        for key in self.touching_pairs(i):
+            p = self.index[key]
+            delta, _ = s.penetration(p)
+            k, e = s.law[p, 0], s.law[p, 1]
+            share = 1.0 if key[1] < 0 else 0.5
+            total += share * k * max(delta, 0.0) ** (e + 1.0) / (e + 1.0)
+        return total
+
     def touching_pairs(self, i: int) -> list:
         s = self._ready()
         return [k for k, p in self.index.items() if i in k[:1] + k[1:] and s.touching[p]]

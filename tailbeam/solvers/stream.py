@@ -38,7 +38,7 @@ from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import quiet, task
 from tailbeam.solvers.broadphase import candidate_pairs
 from tailbeam.solvers.records import PLATE, ContactRecord, EventKind, LeaveEvent
-from tailbeam.solvers.stream_state import ACTIVE, FLY, GONE, SLIDE, Balls, LawOptions
+from tailbeam.solvers.stream_state import ACTIVE, FLY, GONE, PENDING, SLIDE, Balls, LawOptions
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
@@ -164,12 +164,19 @@ class _Stream:
         self.loads, self.dead_loads = [], []
         self.stats = dict.fromkeys(
             (
-                "heap_events", "stale", "set_events", "set_calls", "epochs", "late_starts",
+                "heap_events",
+                "stale",
+                "set_events",
+                "set_calls",
+                "epochs",
+                "late_starts",
                 "postponed_releases",
             ),
             0,
         )
-        self.stats["rest_energy_removed"] = 0.0
+        # the energy ledger (J): released = left + at the end + removed at rest + dissipated
+        for key in ("rest_energy_removed", "energy_released", "energy_left", "energy_final"):
+            self.stats[key] = 0.0
         self.epoch = self._epoch_length()
 
     # --- setup ----------------------------------------------------------------------------
@@ -288,6 +295,7 @@ class _Stream:
             self.push(b.t_release[i], _RELEASE, i)
             return
         b.set_motion(i, FLY, self.t, b.x0[i].copy(), b.v0[i].copy())
+        self.stats["energy_released"] += self._ball_energy(i, *b.state(i, self.t))
         self.events.append((self.t, EventKind.RELEASE, b.names[i], ""))
         self._predict(i)
         if self.act.members:
@@ -365,6 +373,7 @@ class _Stream:
 
     def _leave(self, i: int, edge: str, t: float):
         b = self.balls
+        self.stats["energy_left"] += self._ball_energy(i, *b.state(i, t)) + self._elastic(i)
         if b.status[i] == SLIDE:
             self._dead_load(i, t)
         b.status[i] = GONE
@@ -400,6 +409,7 @@ class _Stream:
     def _on_leave(self, what):
         i, edge = what
         b = self.balls
+        self.stats["energy_left"] += self._ball_energy(i, *self.act.state(i)) + self._elastic(i)
         for key in self.act.touching_pairs(i):
             if key in self.open:
                 self._close(key, "left")
@@ -458,7 +468,6 @@ class _Stream:
             depth = max(depth, float(np.max(b.radius[m] + b.radius[i] - d)))
         if depth > 1e-12:
             self.stats["late_starts"] += 1
-
 
     def _release_from_core(self, i: int):
         """Core ball i touches nothing any more (or only rests on the plate): closed form."""
@@ -588,9 +597,33 @@ class _Stream:
         for q in range(k):
             self.dead_loads.append((mid[q, 0], mid[q, 1], edges[q], edges[q + 1], weight))
 
+    def _ball_energy(self, i: int, x, v) -> float:
+        """Kinetic plus gravitational energy of ball i (J; potential 0 at the origin)."""
+        b = self.balls
+        return float(0.5 * b.mass[i] * (v @ v) - b.mass[i] * (b.g @ x))
+
+    def _elastic(self, i: int) -> float:
+        """Elastic energy (J) of the contacts of ball i: its plate contact (quiet or not) and
+        half of each ball-ball contact (the other half is its partner's)."""
+        if i not in self.act.members:
+            law, pen = self.balls.plate_laws[i], self.balls.static_pen[i]
+            rests = self.balls.status[i] == SLIDE
+            return law.stiffness * pen ** (law.exponent + 1) / (law.exponent + 1) if rests else 0.0
+        return self.act.elastic_energy_of(i)
+
+    def _final_energy(self) -> float:
+        b = self.balls
+        total = 0.0
+        for i in np.flatnonzero((b.status != GONE) & (b.status != PENDING)):
+            i = int(i)
+            x, v = self.act.state(i) if b.in_set[i] else b.state(i, self.t)
+            total += self._ball_energy(i, x, v) + self._elastic(i)
+        return total
+
     def _finish(self, wall: float) -> StreamRun:
         b = self.balls
         self.t = self.duration
+        self.stats["energy_final"] = self._final_energy()
         for key in list(self.open):
             recs = self.open.pop(key)
             peak, t_peak, pen = self.act.accumulators(key)
