@@ -241,15 +241,6 @@ class Scene:
                     f"its particles are named {s.name}-1, {s.name}-2, ...; a ball is already "
                     f"called {clash[0]!r}",
                 )
-        if self.inclination != 0.0 and self.plate_model == "modal":
-            raise InputError(
-                "plate.inclination",
-                "an inclined modal plate: not yet (use plate.model = 'rigid' or inclination 0)",
-            )
-        if self.streams and self.plate_model == "modal":
-            raise InputError(
-                "streams", "streams on the modal plate: not yet (use plate.model = 'rigid')"
-            )
 
     @property
     def incline(self):
@@ -301,11 +292,9 @@ class Scene:
 
     @functools.cached_property
     def needs_stream_solver(self) -> bool:
-        """A rigid plate with streams, an inclination or balls that may touch each other:
-        the stream solver (tailbeam.simulation); otherwise the single-ball solvers are exact
-        and used (the modal plate refuses such scenes for now)."""
-        if self.plate_model != "rigid":
-            return False
+        """Streams, an inclination or balls that may touch each other: the stream solver
+        (tailbeam.simulation; on the modal plate its contact forces then drive the plate one
+        way); otherwise the single-ball solvers are exact and used."""
         return bool(self.streams) or self.inclination != 0.0 or bool(self.first_ball_contact())
 
 

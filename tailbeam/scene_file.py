@@ -29,7 +29,6 @@ from tailbeam.scene import (
     ModalPlateSettings,
     Scene,
     SensorSpec,
-    check_no_ball_contact,
     default_label,
 )
 
@@ -109,8 +108,6 @@ def parse_scene(data: dict) -> Scene:
     incline = InclinedPlate(plate, **kwargs)  # validates plate.inclination
     duration = require_positive("duration", data["duration"])
     balls, labels = _parse_balls(data.get("balls", []), materials, plate, "streams" in data)
-    if model == "modal":
-        check_no_ball_contact(balls, duration)
     streams = _parse_streams(data.get("streams", []), incline, materials)
     sensors = _parse_sensors(data.get("sensors", []), plate)
     if sensors and model != "modal":

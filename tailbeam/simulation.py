@@ -17,6 +17,7 @@ import contextlib
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.progress import note, quiet, task
 
+STREAM_MIN_BAND_HZ = 10_000.0  # modal band of a stream scene without sensors or plate.fmax
 MAX_STREAM_MEMORY = 2e9  # bytes the reference may keep (its step budget x state size)
 
 
@@ -44,10 +45,13 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
         raise InputError("scene", f"must be a tailbeam.scene.Scene, got {type(scene).__name__}")
     how = {k: v for k, v in (("rtol", rtol), ("max_steps", max_steps)) if v is not None}
     with contextlib.nullcontext() if progress else quiet():
+        if scene.needs_stream_solver:
+            result = _stream(scene, how)
+            if scene.plate_model == "modal":
+                _modal_sensors(scene, result)
+            return result
         if scene.plate_model == "modal":
             return _modal(scene, how)
-        if scene.needs_stream_solver:
-            return _stream(scene, how)
         return _rigid(scene, how)
 
 
@@ -62,11 +66,9 @@ def _rigid(scene, how):
 
 def _modal(scene, how):
     from tailbeam.coupled import simulate_scene_modal
-    from tailbeam.scene import check_no_ball_contact
 
     if how:
         raise InputError(next(iter(how)), "is not a setting of the modal plate solver")
-    check_no_ball_contact(scene.balls, scene.duration)
     # The modal path chooses its band from the scene (contact durations, sensor bandwidths),
     # the theory from the band, and records both choices in result.info.
     return simulate_scene_modal(scene)
@@ -88,9 +90,8 @@ def _stream(scene, how):
         )
     note(
         f"{_why_stream(scene)}: stream solver = {engine.name}, {len(particles)} particles, "
-        f"rtol {rtol:g}, at most {max_steps} steps (<= {memory / 1e6:.0f} MB, <= ~{worst / 60:.0f}"
-        " min at the measured cost per step; examples/small_stream.toml takes ~1400 steps per"
-        " simulated second)"
+        f"rtol {rtol:g}, work bound {max_steps} steps (estimated <= {memory / 1e6:.0f} MB, "
+        f"~{worst:.0f} s or less)"
     )
     with task(f"simulating {scene.duration:g} s", total=scene.duration, unit="s") as bar:
         reached = [0.0]
@@ -102,6 +103,46 @@ def _stream(scene, how):
         return engine.run(
             particles, scene.incline, scene.duration, laws=scene.contact, rtol=rtol,
             max_steps=max_steps, progress=advance,
+        )  # fmt: skip
+
+
+def _modal_sensors(scene, result):
+    """One-way coupling of a stream on the modal plate: the stream's plate forces (rigid
+    plate contacts, ``result.loads``) drive the modes; the sensors read the plate there
+    (tailbeam.coupled.load_response). Band: plate.fmax, else the sensors' bandwidth."""
+    from tailbeam.coupled.auto import _choices, build_basis
+    from tailbeam.coupled.load_response import sensor_outputs
+    from tailbeam.coupled.loads import PlateLoads
+    from tailbeam.coupled.solver import modal_damping
+    from tailbeam.scene import ModalPlateSettings
+    from tailbeam.sensor import resolve
+
+    settings = scene.modal or ModalPlateSettings()
+    f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
+    fmax = settings.fmax_hz or max(f_sensor, STREAM_MIN_BAND_HZ)
+    band = {
+        "fmax_hz": float(fmax), "user_fmax": settings.fmax_hz is not None,
+        "reason": "plate.fmax" if settings.fmax_hz else "the sensors' bandwidth",
+        "sensor_band_covered": bool(fmax >= f_sensor), "truncation_force_error": 0.0,
+        "coupling": "one-way (stream contacts on the rigid plate drive the modes)",
+    }  # fmt: skip
+    basis = build_basis(scene, band)
+    result.info.update(_choices(band, basis))
+    note(
+        f"modal plate under a stream: one-way coupling, band 0-{fmax / 1e3:.1f} kHz "
+        f"({band['reason']}), {basis.theory}, {basis.n_modes} modes"
+    )
+    contacts, dead = result.loads
+    loads = PlateLoads()
+    for x, y, t, f in contacts:
+        loads.add_contact(x, y, t, f)
+    for x, y, t0, t1, f in dead:
+        loads.add_dead_load(x, y, t0, t1, f)
+    zeta = modal_damping(basis.omega, settings.damping_ratio, settings.rayleigh)
+    with task(f"sensor signals, {len(scene.sensors)} sensors, {loads.n_nodes} load nodes"):
+        result.sensors = sensor_outputs(
+            basis, zeta, loads, scene.sensors, scene.duration,
+            quasi_static=settings.residual_flexibility,
         )  # fmt: skip
 
 

@@ -72,11 +72,16 @@ def write_stream_results(out_dir, scene, result) -> list:
     from tailbeam.scene_file import scene_to_dict
     from tailbeam.solvers.stream_result import PARTICLE_UNITS, STREAM_IMPACT_UNITS
 
-    return [
+    files = [
         write_table_csv(out_dir / "impacts.csv", result.impacts_table(), STREAM_IMPACT_UNITS),
         write_table_csv(out_dir / "particles.csv", result.particles_table(), PARTICLE_UNITS),
         write_json(out_dir / "impacts.json", stream_summary(result, scene_to_dict(scene))),
     ]
+    if result.sensors:
+        n = len(result.sensors)
+        with task(f"sensor outputs, {n} sensors", total=n, unit="sensors") as bar:
+            files += _write_sensors(out_dir, scene, result, result.sensors, bar)
+    return files
 
 
 def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
@@ -115,7 +120,9 @@ def run(args) -> int:
 
     check_output_dir(args.out)
     scene = load_scene(args.scene)
-    if not scene.needs_stream_solver:
+    if scene.needs_stream_solver:
+        announce_first_compile("solvers")
+    else:
         announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
     result = solve(scene)
     with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:

@@ -31,8 +31,9 @@ class ContactRecord:
     v_out = v . n at the end (> 0 leaving); approach_in / approach_out: the same for the
     relative velocity of the pair (penetration rate at start, minus it at the end).
     peak_force (N) at t_peak, max_penetration (m); x, y: contact point in the plate frame
-    at first touch (m). end: ``separated``, ``left`` (a ball left the plate during the
-    contact) or ``duration`` (the simulation ended during it; v_out etc. are nan).
+    at first touch (m). end: ``separated``, ``rest`` (the ball came to rest on the plate: the
+    fast stream solver's rest rules), ``left`` (a ball left the plate during the contact) or
+    ``duration`` (the simulation ended during it; v_out etc. are nan).
     """
 
     ball: str

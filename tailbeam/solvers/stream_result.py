@@ -24,13 +24,14 @@ row for each of the two balls), in this order:
   ``next_apex_height`` (plate rows: the height of the ball's lowest point above the plate at
   the apex of the following normal flight, v_out^2 / (2 g cos theta); nan if the contact did
   not end by separation, if there is no normal gravity, if the ball touches anything or
-  leaves the plate before that apex, or for ball rows); ``ends_at_rest`` (always false:
-  the stream solvers integrate every contact to its end and declare no rest; a contact still
-  open when the simulation ends has ``end`` = ``duration``);
+  leaves the plate before that apex, or for ball rows); ``ends_at_rest`` (true when the
+  contact ended with the ball at rest on the plate: ``end`` = ``rest``, see
+  ``tailbeam.solvers.stream``; the reference solver never declares rest);
 - then ``partner`` (``plate`` or the other ball's name), ``x``, ``y`` (contact point in the
   plate frame at first touch, m), ``material``, ``radius`` (m) of the row's ball;
 - then ``label`` (coal / gangue), ``stream`` (empty for ``[[balls]]``), ``end``
-  (``separated``, ``left``: the ball left the plate during the contact, ``duration``),
+  (``separated``; ``rest``: the ball came to rest on the plate and slides on as a dead load;
+  ``left``: the ball left the plate during the contact; ``duration``),
   ``approach_in``, ``approach_out`` (m/s, the pair's normal approach speed at first touch
   and its separation speed at the end).
 """
@@ -92,6 +93,14 @@ class StreamResult:
     stats: dict = field(default_factory=dict)
     sensors: dict | None = None
     info: dict = field(default_factory=dict)
+    loads: tuple | None = None  # (contact force histories, dead loads): fast solver only
+
+    @property
+    def sensor_signals(self) -> dict:
+        """name -> (t s, acceleration m/s^2) of the sensors (modal plate), for sensors.csv."""
+        from tailbeam.coupled.load_response import sensor_signals
+
+        return sensor_signals(self.sensors or {})
 
     @property
     def impacts(self) -> list:
@@ -134,14 +143,14 @@ def _starts_by_ball(contacts) -> dict:
 
 
 def _impact_row(rec, index, particle, g_n, starts, leave) -> tuple:
-    separated = rec.end == "separated"
+    separated = rec.end in ("separated", "rest")
     restitution = (
         rec.approach_out / rec.approach_in if separated and rec.approach_in > 0.0 else math.nan
     )
     return (
         rec.ball, index, rec.t_start, rec.t_end, rec.v_in, rec.v_out, restitution,
         rec.peak_force, rec.t_peak, rec.max_penetration,
-        _next_apex(rec, g_n, starts.get(rec.ball), leave.get(rec.ball)), False,
+        _next_apex(rec, g_n, starts.get(rec.ball), leave.get(rec.ball)), rec.end == "rest",
         rec.partner, rec.x, rec.y, particle.material.name, particle.radius,
         particle.label, particle.stream, rec.end, rec.approach_in, rec.approach_out,
     )  # fmt: skip

@@ -1,0 +1,258 @@
+"""The active set as the stream driver sees it: members by ball number, pairs by key.
+
+``tailbeam.solvers.active_set.ActiveSet`` integrates a fixed list of balls and pairs. Here
+members come and go (a ball lands, a neighbour comes within reach, a ball flies off), so the
+set is rebuilt on the next ``advance`` after a change, carrying over each pair's state
+(touching, region flags, peak force, maximum penetration) by its key: (i, -1) for ball i on
+the plate, (i, j) with i < j for two balls. Every pair among the members is watched (sets are
+small: the balls near a contact).
+"""
+
+import math
+
+import numpy as np
+
+from tailbeam.contact_law import ball_ball_law
+from tailbeam.physics.incline import EDGES
+from tailbeam.solvers.active_pairs import first_contact_step, settle_excess
+from tailbeam.solvers.active_set import ActiveSet, law_table
+
+_KIND = {"contact_start": "start", "contact_end": "end", "leave": "leave", "settle": "settle"}
+
+
+class ActiveMembers:
+    """Members (ball numbers of ``balls``: a ``stream_state.Balls``) and their pairs."""
+
+    def __init__(self, balls, options, rtol, settle_energy):
+        self.balls, self.options, self.rtol = balls, options, rtol
+        self.settle_energy = settle_energy  # ball number -> J
+        self.members = []
+        self.quiet = set()  # members resting on the plate (no SETTLE for them)
+        self.keys, self.index = [], {}
+        self.set = None
+        self.dirty = True
+        self.h = 0.0
+        self._laws = {}
+        self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
+        self.totals = {"kernel_steps": 0, "kernel_attempts": 0, "kernel_nfev": 0, "rebuilds": 0}
+        self._x = {}  # state of members added since the last build
+        self._v = {}
+
+    # --- membership -----------------------------------------------------------------------------
+    def add(self, i: int, x, v, *, quiet: bool):
+        self._sync()
+        self.members.append(i)
+        self._x[i], self._v[i] = np.array(x, dtype=float), np.array(v, dtype=float)
+        if quiet:
+            self.quiet.add(i)
+        self.dirty = True
+
+    def remove(self, i: int):
+        self._sync()
+        self.members.remove(i)
+        self._x.pop(i, None)
+        self._v.pop(i, None)
+        self.quiet.discard(i)
+        self.dirty = True
+
+    def _sync(self):
+        """Keep the current states of the built set's members before a change."""
+        if self.set is None or self.dirty:
+            return
+        for q, i in enumerate(self.members):
+            self._x[i], self._v[i] = self.set.x[q].copy(), self.set.v[q].copy()
+        self._pairs = {k: self._pair_state(p) for k, p in self.index.items()}
+
+    def _pair_state(self, p):
+        s = self.set
+        return (s.touching[p], s.ramp[p], s.clamped[p], s.peak[p], s.t_peak[p], s.pen[p])
+
+    def _law(self, i, j):
+        key = (i, j)
+        if key not in self._laws:
+            b = self.balls
+            pi, pj = b.particles[i], b.particles[j]
+            law = ball_ball_law(
+                pi.material, pi.radius, pj.material, pj.radius, **self.options.kwargs()
+            )
+            self._laws[key] = law
+        return self._laws[key]
+
+    def _build(self):
+        b, m = self.balls, self.members
+        old = getattr(self, "_pairs", {}) if self.set is not None else {}
+        self.keys = [(i, -1) for i in m] + [
+            (min(i, j), max(i, j)) for a, i in enumerate(m) for j in m[a + 1 :]
+        ]
+        local = {i: q for q, i in enumerate(m)}
+        pairs = [(local[i], -1 if j < 0 else local[j]) for i, j in self.keys]
+        laws = [b.plate_laws[i] if j < 0 else self._law(i, j) for i, j in self.keys]
+        settle = [0.0 if i in self.quiet else self.settle_energy(i) for i in m]
+        self._count()
+        self.set = ActiveSet(
+            [self._x[i] for i in m], [self._v[i] for i in m], b.mass[m], b.radius[m],
+            np.array(pairs, dtype=np.int64).reshape(-1, 2), law_table(laws), b.g, b.half,
+            settle_energy=np.array(settle), rtol=self.rtol,
+        )  # fmt: skip
+        self.index = {k: p for p, k in enumerate(self.keys)}
+        s = self.set
+        for k, p in self.index.items():
+            if k in old:
+                s.touching[p], s.ramp[p], s.clamped[p], s.peak[p], s.t_peak[p], s.pen[p] = old[k]
+        s.h = self.h
+        self.local = local
+        self.dirty = False
+        self.totals["rebuilds"] += 1
+
+    def _count(self):
+        if self.set is not None:
+            st = self.set.stats
+            self.totals["kernel_steps"] += st["steps"]
+            self.totals["kernel_attempts"] += st["attempts"]
+            self.totals["kernel_nfev"] += st["nfev"]
+            self.set.iout[3:6] = 0  # counted
+
+    def _ready(self):
+        if self.dirty:
+            self._build()
+        return self.set
+
+    # --- integration ----------------------------------------------------------------------------
+    def advance(self, t: float, t_stop: float):
+        """Integrate the members from t to t_stop or their first event: (kind, key, t_new),
+        kind None (reached t_stop), "start"/"end" (key: pair key), "leave" (key: (ball, edge
+        name)) or "settle" (key: ball)."""
+        s = self._ready()
+        out = s.advance(t, t_stop, self.h or None)
+        self.h = s.h
+        self._drain()
+        kind = _KIND.get(out.kind)
+        if kind is None:
+            return None, None, out.t
+        if kind in ("start", "end"):
+            return kind, self.keys[out.index], out.t
+        ball = self.members[out.index]
+        return kind, (ball, EDGES[out.edge]) if kind == "leave" else ball, out.t
+
+    def _drain(self):
+        """Move the plate force rows of the last advance into each ball's node lists."""
+        s = self.set
+        rows = s.force_rows()
+        if len(rows):
+            pairs = rows[:, 1].astype(np.int64)
+            for p in np.unique(pairs):
+                i = self.keys[p][0]
+                sel = rows[pairs == p]
+                entry = self.nodes.get(i)
+                if entry is None:
+                    x = s.x[self.local[i]]
+                    entry = self.nodes[i] = [float(x[0]), float(x[1]), [], []]
+                entry[2].append(sel[:, 0].copy())
+                entry[3].append(sel[:, 2].copy())
+        self.kinks = s.kink_log()
+        s.clear_outputs()
+
+    def take_plate_forces(self, i: int):
+        """(x, y, t_nodes, forces) of ball i's plate force since the last take, or None."""
+        entry = self.nodes.pop(i, None)
+        if entry is None:
+            return None
+        t = np.concatenate(entry[2])
+        f = np.concatenate(entry[3])
+        order = np.argsort(t, kind="stable")
+        return entry[0], entry[1], t[order], f[order]
+
+    # --- state ----------------------------------------------------------------------------------
+    def state(self, i: int):
+        """Position (m) and velocity (m/s) of member i now."""
+        if self.dirty:
+            return self._x[i], self._v[i]
+        q = self.local[i]
+        return self.set.x[q].copy(), self.set.v[q].copy()
+
+    def positions(self, idx) -> np.ndarray:
+        return np.array([self.state(int(i))[0] for i in idx]).reshape(-1, 3)
+
+    def energy(self, balls) -> float:
+        """Kinetic energy of ``balls`` (members) plus the elastic energy of all contacts (J):
+        what a contact among them can give to one of them."""
+        s = self._ready()
+        q = [self.local[int(i)] for i in balls]
+        kinetic = 0.5 * float(np.sum(s.mass[q] * np.sum(s.v[q] * s.v[q], axis=1)))
+        elastic = 0.0
+        for p in np.flatnonzero(s.touching):
+            delta, _ = s.penetration(p)
+            k, e = s.law[p, 0], s.law[p, 1]
+            elastic += k * max(delta, 0.0) ** (e + 1.0) / (e + 1.0)
+        return kinetic + elastic
+
+    def elastic_energy_of(self, i: int) -> float:
+        """Elastic energy (J) of member i's touching plate pair plus half of each of its
+        touching ball-ball pairs."""
+        s = self._ready()
+        total = 0.0
+        for key in self.touching_pairs(i):
+            p = self.index[key]
+            delta, _ = s.penetration(p)
+            k, e = s.law[p, 0], s.law[p, 1]
+            share = 1.0 if key[1] < 0 else 0.5
+            total += share * k * max(delta, 0.0) ** (e + 1.0) / (e + 1.0)
+        return total
+
+    def touching_pairs(self, i: int) -> list:
+        s = self._ready()
+        return [k for k, p in self.index.items() if i in k[:1] + k[1:] and s.touching[p]]
+
+    def start_contact(self, key):
+        """Pair ``key`` starts touching now (its start was found in closed form)."""
+        s = self._ready()
+        p = self.index[key]
+        delta, _ = s.penetration(p)
+        s.touching[p], s.ramp[p], s.clamped[p] = True, True, False
+        s.peak[p], s.t_peak[p], s.pen[p] = 0.0, math.nan, max(delta, 0.0)
+        step = first_contact_step(s.y, s.model(), p, self.rtol)
+        self.h = min(self.h, step) if self.h else step
+
+    def reset_accumulators(self, key):
+        s = self._ready()
+        p = self.index[key]
+        s.peak[p], s.t_peak[p], s.pen[p] = 0.0, math.nan, max(s.penetration(p)[0], 0.0)
+
+    def accumulators(self, key):
+        """(peak force N, its time s, maximum penetration m) of pair ``key``."""
+        s = self._ready()
+        p = self.index[key]
+        return float(s.peak[p]), float(s.t_peak[p]), float(s.pen[p])
+
+    def make_quiet(self, i: int) -> float:
+        """Put ball i at rest on the plate (static penetration, no normal speed); returns the
+        normal excess energy (J) this removes."""
+        s = self._ready()
+        q, p = self.local[i], self.index[(i, -1)]
+        removed = float(settle_excess(s.y, s.model(), p, q)) if s.touching[p] else 0.0
+        if not s.touching[p]:  # a slow rebound: the energy of the normal motion above rest
+            removed = 0.5 * s.mass[q] * s.v[q, 2] ** 2
+        s.x[q, 2] = self.balls.radius[i] - self.balls.static_pen[i]
+        s.v[q, 2] = 0.0
+        law = s.law[p]
+        s.touching[p] = True
+        s.ramp[p] = self.balls.static_pen[i] < law[3] or law[2] <= 0.0
+        s.clamped[p] = False
+        s.settle_energy[q] = 0.0
+        self.quiet.add(i)
+        return removed
+
+    def wake(self, i: int):
+        """Ball i takes part in a contact again: SETTLE may end its plate contact again."""
+        if i in self.quiet:
+            self.quiet.discard(i)
+            s = self._ready()
+            s.settle_energy[self.local[i]] = self.settle_energy(i)
+
+    def steps(self) -> int:
+        """Kernel steps so far (accepted)."""
+        return self.totals["kernel_steps"] + (self.set.stats["steps"] if self.set else 0)
+
+    def stats(self) -> dict:
+        self._count()
+        return dict(self.totals)
