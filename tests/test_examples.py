@@ -32,4 +32,4 @@ def test_example_scenes_are_valid():
     assert len(scenes) >= 3
     for path in scenes:
         scene = load_scene(path)
-        assert scene.balls
+        assert scene.balls or scene.streams

@@ -1,0 +1,151 @@
+"""Caving streams: speed, memory and accuracy of the stream solver (issue 7's reference scene).
+
+    python benchmarks/bench_stream.py [--out DIR] [--quick]
+
+The scene is ``examples/caving_stream.toml``: particles released at 200 per second from
+0.3-0.8 m above a 0.4 x 0.4 m area of a 30-degree SSSS plate, radii 10-40 mm, 30 % gangue,
+damping 300 N s/m; the stream lasts n / 200 s and the simulation 1 s longer (6 s for the
+reference scene's 1000 particles). Every case runs in its own process (``tailbeam.simulate``
+timed inside it; peak memory = the process's maximum resident set, numba and the basis
+included), after one warm-up run that fills the numba and basis caches.
+
+Rows:
+- cost against particle count at the same rate (100, 300, 1000, 3000 particles, rigid
+  plate): wall time, contacts, and the fitted exponent of time against particles;
+- the reference scene on the modal plate (band 10 kHz, basis cached, two 51.2 kHz sensors:
+  the stream's plate forces drive the modes one way) against the same on the rigid plate;
+- accuracy against converged runs: first-impact peak force of every particle at rtol 1e-10
+  (the default) against rtol 1e-12; in-band sensor RMS with the 10 kHz band against a 20 kHz
+  band.
+"""
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "examples" / "caving_stream.toml"
+RATE = 200.0
+
+
+def scene_text(n: int, model: str, fmax: float = 10000.0) -> str:
+    """The reference scene with n particles (stream n / RATE s, simulation 1 s longer)."""
+    stop = n / RATE
+    text = SCENE.read_text()
+    text = text.replace("duration = 6.0 ", f"duration = {stop + 1.0!r} ")
+    text = text.replace("stop = 5.0 ", f"stop = {stop!r} ")
+    text = text.replace('model = "modal"', f'model = "{model}"')
+    text = text.replace("fmax = 10000.0", f"fmax = {fmax!r}")
+    if model == "rigid":
+        text = text[: text.index("[[sensors]]")]
+    return text
+
+
+def run_case(path: str, rtol: float) -> dict:
+    """Child process: simulate the scene file, report wall time, peak memory, results."""
+    import resource
+
+    import tailbeam
+    from tailbeam.scene_file import load_scene
+
+    scene = load_scene(path)
+    t0 = time.perf_counter()
+    result = tailbeam.simulate(scene, rtol=rtol, progress=False)
+    wall = time.perf_counter() - t0
+    first = {}
+    for rec in sorted(result.contacts, key=lambda r: r.t_start):
+        if rec.partner == "plate" and rec.ball not in first:
+            first[rec.ball] = rec.peak_force
+    rms = {
+        name: float(np.sqrt(np.mean(out.acceleration**2)))
+        for name, out in (result.sensors or {}).items()
+    }
+    return {
+        "wall_s": wall,
+        "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        "particles": len(result.particles),
+        "contacts": len(result.contacts),
+        "kernel_steps": result.stats.get("kernel_steps"),
+        "first_peaks": first,
+        "sensor_rms": rms,
+    }
+
+
+def _in_child(out_dir: Path, name: str, text: str, rtol: float = 1e-10) -> dict:
+    path = out_dir / f"{name}.toml"
+    path.write_text(text)
+    here = str(Path(__file__).parent)
+    code = (
+        f"import json, sys; sys.path.insert(0, {here!r}); import bench_stream as b; "
+        f"print(json.dumps(b.run_case({str(path)!r}, {rtol!r})))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    if done.returncode:
+        raise RuntimeError(done.stderr[-2000:])
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def _worst(a: dict, b: dict) -> float:
+    common = sorted(set(a) & set(b))
+    return max(abs(a[k] - b[k]) / abs(b[k]) for k in common)
+
+
+def main(out_dir="out/bench_stream", quick: bool = False) -> Path:
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    counts = [100, 300, 1000] if quick else [100, 300, 1000, 3000]
+    _in_child(out_dir, "warm_rigid", scene_text(100, "rigid"))
+    _in_child(out_dir, "warm_modal", scene_text(100, "modal"))
+    rows, results = [], {}
+    for n in counts:
+        results[n] = r = _in_child(out_dir, f"rigid_{n}", scene_text(n, "rigid"))
+        rows.append((f"rigid, {n} particles ({n / RATE + 1:g} s)", r))
+        print(f"rigid {n}: {r['wall_s']:.2f} s", file=sys.stderr)
+    modal = _in_child(out_dir, "modal_1000", scene_text(1000, "modal"))
+    rows.append(("modal 10 kHz + 2 sensors, 1000 particles (6 s)", modal))
+    n = np.array(counts, dtype=float)
+    wall = np.array([results[k]["wall_s"] for k in counts])
+    exponent = float(np.polyfit(np.log(n), np.log(wall), 1)[0])
+    tight = _in_child(out_dir, "rigid_1000_tight", scene_text(1000, "rigid"), rtol=1e-12)
+    converged = _in_child(out_dir, "modal_1000_20k", scene_text(1000, "modal", 20000.0))
+    peak_error = _worst(results[1000]["first_peaks"], tight["first_peaks"])
+    rms_error = _worst(modal["sensor_rms"], converged["sensor_rms"])
+    lines = [
+        "| case | wall (s) | peak memory (MB) | particles | contacts | kernel steps |",
+        "|---|---|---|---|---|---|",
+    ]
+    for label, r in rows:
+        lines.append(
+            f"| {label} | {r['wall_s']:.2f} | {r['peak_rss_mb']:.0f} | {r['particles']} | "
+            f"{r['contacts']} | {r['kernel_steps']} |"
+        )
+    lines += [
+        "",
+        f"Fitted exponent of wall time against particles (rigid, {counts}): {exponent:.3f}.",
+        f"First-impact peak forces, rtol 1e-10 vs 1e-12 (every particle): worst {peak_error:.2e}.",
+        f"Sensor RMS, band 10 kHz vs 20 kHz (S1, S2): worst {rms_error:.2e} "
+        f"({modal['sensor_rms']} vs {converged['sensor_rms']}).",
+    ]
+    table = out_dir / "table.md"
+    table.write_text("\n".join(lines) + "\n")
+    (out_dir / "results.json").write_text(
+        json.dumps({"rows": {k: {q: v for q, v in r.items() if q != "first_peaks"}
+                             for k, r in rows}, "exponent": exponent,
+                    "peak_error": peak_error, "rms_error": rms_error}, indent=1,
+                   default=float)  # fmt: skip
+    )
+    print(table.read_text())
+    return table
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default="out/bench_stream")
+    parser.add_argument("--quick", action="store_true", help="100-1000 particles only")
+    args = parser.parse_args()
+    main(args.out, quick=args.quick)
