@@ -41,8 +41,10 @@ def scene_text(n: int, model: str, fmax: float = 10000.0) -> str:
     text = text.replace("stop = 5.0 ", f"stop = {stop!r} ")
     text = text.replace('model = "modal"', f'model = "{model}"')
     text = text.replace("fmax = 10000.0", f"fmax = {fmax!r}")
-    if model == "rigid":
+    if model == "rigid":  # no modal keys, no sensors
         text = text[: text.index("[[sensors]]")]
+        keep = [ln for ln in text.splitlines() if not ln.startswith(("boundary", "fmax"))]
+        text = "\n".join(keep) + "\n"
     return text
 
 
@@ -134,10 +136,16 @@ def main(out_dir="out/bench_stream", quick: bool = False) -> Path:
     table = out_dir / "table.md"
     table.write_text("\n".join(lines) + "\n")
     (out_dir / "results.json").write_text(
-        json.dumps({"rows": {k: {q: v for q, v in r.items() if q != "first_peaks"}
-                             for k, r in rows}, "exponent": exponent,
-                    "peak_error": peak_error, "rms_error": rms_error}, indent=1,
-                   default=float)  # fmt: skip
+        json.dumps(
+            {
+                "rows": {k: {q: v for q, v in r.items() if q != "first_peaks"} for k, r in rows},
+                "exponent": exponent,
+                "peak_error": peak_error,
+                "rms_error": rms_error,
+            },
+            indent=1,
+            default=float,
+        )  # fmt: skip
     )
     print(table.read_text())
     return table
