@@ -59,10 +59,13 @@ def run_case(path: str, rtol: float) -> dict:
     t0 = time.perf_counter()
     result = tailbeam.simulate(scene, rtol=rtol, progress=False)
     wall = time.perf_counter() - t0
-    first = {}
+    first, touched = {}, set()
     for rec in sorted(result.contacts, key=lambda r: r.t_start):
-        if rec.partner == "plate" and rec.ball not in first:
-            first[rec.ball] = rec.peak_force
+        if rec.partner != "plate":
+            touched.add(rec.ball)
+        elif rec.ball not in first:
+            # (peak force, start time, whether a ball-ball contact came first)
+            first[rec.ball] = (rec.peak_force, rec.t_start, rec.ball in touched)
     rms = {
         name: float(np.sqrt(np.mean(out.acceleration**2)))
         for name, out in (result.sensors or {}).items()
@@ -97,6 +100,18 @@ def _worst(a: dict, b: dict) -> float:
     return max(abs(a[k] - b[k]) / abs(b[k]) for k in common)
 
 
+def first_impacts(a: dict, b: dict) -> dict:
+    """First plate impacts of two runs of one stream. A stream is chaotic: a tiny difference
+    changes which balls meet in flight, and then everything after. So compare the particles
+    whose first plate impact starts at the same time (1e-6 s) in both runs and came before
+    any ball-ball contact of theirs (the impact itself, not the history), and count the rest."""
+    same = [k for k in set(a) & set(b)
+            if not a[k][2] and not b[k][2] and abs(a[k][1] - b[k][1]) < 1e-6]  # fmt: skip
+    errors = np.array([abs(a[k][0] - b[k][0]) / b[k][0] for k in same])
+    return {"compared": len(same), "particles": len(b), "worst": float(errors.max()),
+            "median": float(np.median(errors))}  # fmt: skip
+
+
 def main(out_dir="out/bench_stream", quick: bool = False) -> Path:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -115,7 +130,7 @@ def main(out_dir="out/bench_stream", quick: bool = False) -> Path:
     exponent = float(np.polyfit(np.log(n), np.log(wall), 1)[0])
     tight = _in_child(out_dir, "rigid_1000_tight", scene_text(1000, "rigid"), rtol=1e-12)
     converged = _in_child(out_dir, "modal_1000_20k", scene_text(1000, "modal", 20000.0))
-    peak_error = _worst(results[1000]["first_peaks"], tight["first_peaks"])
+    peaks = first_impacts(results[1000]["first_peaks"], tight["first_peaks"])
     rms_error = _worst(modal["sensor_rms"], converged["sensor_rms"])
     lines = [
         "| case | wall (s) | peak memory (MB) | particles | contacts | kernel steps |",
@@ -129,7 +144,9 @@ def main(out_dir="out/bench_stream", quick: bool = False) -> Path:
     lines += [
         "",
         f"Fitted exponent of wall time against particles (rigid, {counts}): {exponent:.3f}.",
-        f"First-impact peak forces, rtol 1e-10 vs 1e-12 (every particle): worst {peak_error:.2e}.",
+        f"First-impact peak forces, rtol 1e-10 vs 1e-12: {peaks['compared']} of "
+        f"{peaks['particles']} particles comparable (same first impact, no ball-ball contact "
+        f"before it): worst {peaks['worst']:.2e}, median {peaks['median']:.2e}.",
         f"Sensor RMS, band 10 kHz vs 20 kHz (S1, S2): worst {rms_error:.2e} "
         f"({modal['sensor_rms']} vs {converged['sensor_rms']}).",
     ]
@@ -140,7 +157,7 @@ def main(out_dir="out/bench_stream", quick: bool = False) -> Path:
             {
                 "rows": {k: {q: v for q, v in r.items() if q != "first_peaks"} for k, r in rows},
                 "exponent": exponent,
-                "peak_error": peak_error,
+                "first_impacts": peaks,
                 "rms_error": rms_error,
             },
             indent=1,
