@@ -34,6 +34,7 @@ from tailbeam.solvers.active_pairs import (
     first_contact_step,
     pair_force,
     pair_state,
+    region_force,
     rhs,
     rhs_arrays,
     row_band,
@@ -72,7 +73,7 @@ MAX_FRESH = 16
 @helper_njit
 def _stages(K, A, first, stop, y, h, model, pstate, tmp):
     """Runge-Kutta stages first..stop-1 into K (rows: stages)."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
     n = y.shape[0]
     for s in range(first, stop):
@@ -81,16 +82,18 @@ def _stages(K, A, first, stop, y, h, model, pstate, tmp):
             for j in range(s):
                 acc += A[s, j] * K[j, q]
             tmp[q] = y[q] + h * acc
-        rhs_arrays(tmp, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, K[s])
+        rhs_arrays(tmp, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, omega, zeta,
+                   phi, fdead, K[s])  # fmt: skip
 
 
 @helper_njit
-def _step(y, h, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp):
+def _step(y, h, K, tab, rtol, atol, model, pstate, ynew, tmp):
     """One DOP853 step of size h from y (K[0] = f(y) given): ynew, K[12] = f(ynew); returns
-    scipy's error norm (NaN or > 1: reject)."""
-    A, B, E3, E5 = tab[0], tab[1], tab[2], tab[3]
+    scipy's error norm (NaN or > 1: reject), taken separately over the balls and the modal
+    block (the larger: many modes do not dilute the balls' error). atol (N,) per component."""
+    A, B = tab[0], tab[1]
     n = y.shape[0]
-    nb = n // 2  # positions first, then velocities
+    nb6 = 6 * model[0].shape[0]  # balls' positions and velocities, then the modal block
     _stages(K, A, np.int64(1), np.int64(12), y, h, model, pstate, tmp)
     for q in range(n):
         acc = 0.0
@@ -98,20 +101,32 @@ def _step(y, h, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp):
             acc += B[j] * K[j, q]
         ynew[q] = y[q] + h * acc
     rhs(ynew, model, pstate, K[12])
+    err = _block_error(y, ynew, h, K, tab, rtol, atol, np.int64(0), nb6)
+    if n > nb6 and err == err:
+        err_modes = _block_error(y, ynew, h, K, tab, rtol, atol, nb6, n)
+        if not err_modes <= err:
+            err = err_modes
+    return err
+
+
+@helper_njit
+def _block_error(y, ynew, h, K, tab, rtol, atol, lo, hi):
+    """scipy's DOP853 error norm over the components lo..hi-1."""
+    E3, E5 = tab[2], tab[3]
     err5 = 0.0
     err3 = 0.0
-    for q in range(n):
+    for q in range(lo, hi):
         e5 = 0.0
         e3 = 0.0
         for j in range(13):
             e5 += E5[j] * K[j, q]
             e3 += E3[j] * K[j, q]
-        sc = (atol_x if q < nb else atol_v) + rtol * max(abs(y[q]), abs(ynew[q]))
+        sc = atol[q] + rtol * max(abs(y[q]), abs(ynew[q]))
         err5 += (e5 / sc) ** 2
         err3 += (e3 / sc) ** 2
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
-    return h * err5 / math.sqrt((err5 + 0.01 * err3) * n)
+    return h * err5 / math.sqrt((err5 + 0.01 * err3) * (hi - lo))
 
 
 @helper_njit
@@ -194,15 +209,48 @@ def _prepare(dense):
 
 @helper_njit
 def _ensure(Y15, have, coef, y, pts, b):
-    """Ball b's 6 state components at the 15 Chebyshev points of the step (once per step)."""
-    if b < 0 or have[b]:
+    """Ball b's 6 state components at the 15 Chebyshev points of the step (once per step);
+    b < 0 (the plate): the modal block, if any (flag have[n])."""
+    n = have.shape[0] - 1
+    if b < 0:
+        if have[n] or y.shape[0] == 6 * n:
+            return
+        have[n] = True
+        for q in range(pts.shape[0]):
+            for c in range(6 * n, y.shape[0]):
+                Y15[q, c] = _dense1(coef, y, pts[q], c)
+        return
+    if have[b]:
         return
     have[b] = True
-    n = have.shape[0]
     for q in range(pts.shape[0]):
         for k in range(3):
             Y15[q, 3 * b + k] = _dense1(coef, y, pts[q], 3 * b + k)
             Y15[q, 3 * n + 3 * b + k] = _dense1(coef, y, pts[q], 3 * n + 3 * b + k)
+
+
+@helper_njit
+def _project(coef, y, phi, p, off, out):
+    """The dense output of phi[p] . y[off : off + m] (m modes): its 7 coefficients out[:7] and
+    its value at the step start out[7] (the dense output is linear in coef and y)."""
+    nm = phi.shape[1]
+    for i in range(8):
+        out[i] = 0.0
+    for k in range(nm):
+        c = phi[p, k]
+        for i in range(7):
+            out[i] += c * coef[i, off + k]
+        out[7] += c * y[off + k]
+
+
+@helper_njit
+def _dense_projected(c8, s):
+    """A projected dense output (``_project``) at fraction s of the step (as ``_dense1``)."""
+    a = 0.0
+    for i in range(6, -1, -1):
+        a += c8[i]
+        a *= s if (6 - i) % 2 == 0 else 1.0 - s
+    return c8[7] + a
 
 
 @helper_njit
@@ -212,7 +260,7 @@ def _reach(B, b):
 
 
 @helper_njit
-def _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp):
+def _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp, phi):
     """Whether row (kind, idx) is certified positive on the step by the bound B alone:
     edges and centre distances move at most B from their start values (no 15-point
     evaluation needed: far-apart pairs and balls far from the edges cost O(1))."""
@@ -226,8 +274,12 @@ def _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp):
     i, j, rs = pi[idx], pj[idx], rsum[idx]
     if j < 0:
         dist0, reach = y[3 * i + 2], B[3 * i + 2]
+        nm = phi.shape[1]
+        for k in range(nm):  # the deflection phi . q moves by at most sum |phi_k| B_k
+            dist0 -= phi[idx, k] * y[6 * n + k]
+            reach += abs(phi[idx, k]) * B[6 * n + k]
     else:
-        dist0 = rs - pair_state(y, n, i, j, rs)[0]
+        dist0 = rs - pair_state(y, n, i, j, rs, phi, idx)[0]
         reach = _reach(B, i) + _reach(B, j)
     lo, hi = dist0 - reach, dist0 + reach  # the distance stays within [lo, hi]
     margin = 1e-12 * rs
@@ -243,16 +295,17 @@ def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, 
                   pstate):  # fmt: skip
     """First crossing (fraction of the step, inf if none) of row (kind, idx): the bound B,
     else the 15-point certificate, else the search (``cheb_events``)."""
-    if _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp):
+    phi = model[12]
+    if _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp, phi):
         return math.inf
     if kind == R_EDGE:
         _ensure(Y15, have, coef, y, pts, idx // 4)
     else:
         _ensure(Y15, have, coef, y, pts, pi[idx])
-        _ensure(Y15, have, coef, y, pts, pj[idx])
+        _ensure(Y15, have, coef, y, pts, pj[idx])  # (the plate: the modal block)
     for q in range(pts.shape[0]):
         vals[q] = row_value_arrays(
-            kind, idx, Y15[q], n, half, pi, pj, law, rsum, touching, ramp, clamped
+            kind, idx, Y15[q], n, half, pi, pj, law, rsum, touching, ramp, clamped, phi
         )
     if kind == R_CLAMP:
         return _sampled_crossing(kind, idx, vals, fr, y, coef, pts, model, pstate, tmp)
@@ -266,7 +319,7 @@ def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, 
 def _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
     """Earliest (s, kind, idx) of a row crossing in the step; kind -1 if none. (The tuples
     are unpacked once here: the helpers take arrays, see ``rhs_arrays``.)"""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
     Y15, have, coef, y, B = dense
     vals, wc, wv, wc2, wd, stack, tmp = ws
@@ -310,11 +363,11 @@ def _write_row(rows, iout, t, p, f):
 
 
 @helper_njit
-def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
+def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws, proj):
     """Peak force / max penetration of the touching pairs on the accepted step (maximum of
     their Chebyshev interpolant, refined where the nodes come within 1 % of the record), and
     the plate force rows at ``nodes`` interior points and the step end."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     touching, ramp, clamped, peak, t_peak, pen = pstate
     vals, wc, wv, wc2, wd, stack, tmp = ws
     Y15, have, coef, y, B = dense
@@ -326,7 +379,7 @@ def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
         _ensure(Y15, have, coef, y, pts, pj[p])
         fmax = -math.inf
         for q in range(pts.shape[0]):
-            f, delta, _, _, _ = pair_force(Y15[q], n, p, pi, pj, law, rsum, ramp, clamped)
+            f, delta, _, _, _ = pair_force(Y15[q], n, p, pi, pj, law, rsum, ramp, clamped, phi)
             vals[q] = f
             wv[q] = delta
             fmax = max(fmax, f)
@@ -343,22 +396,37 @@ def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
             pen[p] = max(pen[p], interpolant_max(vals, vinv, wc, wc2)[1])
         if pj[p] >= 0:
             continue
-        i = pi[p]
-        for k in range(1, nodes + 1):
-            s = k / (nodes + 1.0)
-            tmp[3 * i + 2] = _dense1(coef, y, s, 3 * i + 2)
-            tmp[3 * n + 3 * i + 2] = _dense1(coef, y, s, 3 * n + 3 * i + 2)
-            f = pair_force(tmp, n, p, pi, pj, law, rsum, ramp, clamped)[0]
-            _write_row(rows, iout, t + s * h, p, f)
-        f = pair_force(ynew, n, p, pi, pj, law, rsum, ramp, clamped)[0]
-        _write_row(rows, iout, t + h, p, f)
+        _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj)
+
+
+@helper_njit
+def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj):
+    """Force rows of plate pair p at ``nodes`` interior points of the step and its end (the
+    plate deflection under the ball from its projected dense output, ``_project``)."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    ramp, clamped = pstate[1], pstate[2]
+    n = mass.shape[0]
+    nm = phi.shape[1]
+    i = pi[p]
+    wq, wv = proj[0], proj[1]
+    _project(coef, y, phi, p, 6 * n, wq)
+    _project(coef, y, phi, p, 6 * n + nm, wv)
+    k_, e_, c_, d_ = law[p, 0], law[p, 1], law[p, 2], law[p, 3]
+    for k in range(1, nodes + 1):
+        s = k / (nodes + 1.0)
+        z = _dense1(coef, y, s, 3 * i + 2) - _dense_projected(wq, s)
+        vz = _dense1(coef, y, s, 3 * n + 3 * i + 2) - _dense_projected(wv, s)
+        f = region_force(rsum[p] - z, -vz, k_, e_, c_, d_, ramp[p], clamped[p])
+        _write_row(rows, iout, t + s * h, p, f)
+    f = pair_force(ynew, n, p, pi, pj, law, rsum, ramp, clamped, phi)[0]
+    _write_row(rows, iout, t + h, p, f)
 
 
 @helper_njit
 def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
     """Apply the event of row (kind, idx) at time t, state y; returns the status to return
     with (ST_START, ST_END, ST_LEAVE) or -1 for a kink handled here (logged)."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     touching, ramp, clamped, peak, t_peak, pen = pstate
     n = mass.shape[0]
     if kind == R_EDGE:
@@ -367,18 +435,18 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
         return ST_LEAVE
     iout[IO_INDEX] = idx
     if kind == R_CONTACT:
-        f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped)[0]
+        f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi)[0]
         if touching[idx]:
             if pj[idx] < 0:
                 _write_row(rows, iout, t, idx, f)
             touching[idx] = False
             return ST_END
         touching[idx], ramp[idx], clamped[idx] = True, True, False
-        delta = pair_state(y, n, pi[idx], pj[idx], rsum[idx])[0]
+        delta = pair_state(y, n, pi[idx], pj[idx], rsum[idx], phi, idx)[0]
         peak[idx], t_peak[idx], pen[idx] = 0.0, math.nan, max(0.0, delta)
         if pj[idx] < 0:
             _write_row(
-                rows, iout, t, idx, pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped)[0]
+                rows, iout, t, idx, pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi)[0]
             )
         return ST_START
     r = iout[IO_LOG]
@@ -413,7 +481,7 @@ def _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
 def _settle(y, model, pstate, count, plate_pair):
     """First ball whose only touching pair is the plate and whose excess energy
     (``settle_excess``) is below its settle energy; -1 if none. Checked at step ends."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     touching = pstate[0]
     n = mass.shape[0]
     for b in range(n):
@@ -447,12 +515,14 @@ def _rows_needed(model, pstate, nodes):
 
 
 @njit(cache=True)
-def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstate, tab,
-            pts, vinv, rows, log, iout):  # fmt: skip
+def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pts, vinv, rows,
+            log, iout):  # fmt: skip
     """Advance the active set from tio[0] with first step tio[1] until an event or t_stop.
 
-    y (6 n,) state in/out. model = (mass, radius, g (3,), half (2,), pi, pj, law (P, 5), rsum,
-    e_settle, alive), pstate = (touching, ramp, clamped, peak, t_peak, pen): per-pair in/out.
+    y (6 n + 2 m,) state in/out (m modes); atol (6 n + 2 m,) absolute tolerance per component.
+    model = (mass, radius, g (3,), half (2,), pi, pj, law (P, 5), rsum, e_settle, alive,
+    omega (m,), zeta (m,), phi (P, m), f_dead (m,)), pstate = (touching, ramp, clamped, peak,
+    t_peak, pen): per-pair in/out.
     tab = DOP853 (A, B, E3, E5, D). rows (R, 3) force rows (t, pair, F) and log (L, 3) kinks
     (t, kind, pair) are appended from iout[IO_ROWS], iout[IO_LOG]. On return: tio = [t, next
     step], iout[IO_STATUS] (ST_*), iout[IO_INDEX] (pair or ball), iout[IO_EDGE], work counts.
@@ -464,10 +534,11 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
     coef = np.zeros((7, nst))
     npts = pts.shape[0]
     nb = model[0].shape[0]
-    dense = (np.zeros((npts, nst)), np.zeros(nb, dtype=np.bool_), coef, np.zeros(nst),
+    dense = (np.zeros((npts, nst)), np.zeros(nb + 1, dtype=np.bool_), coef, np.zeros(nst),
              np.zeros(nst))  # fmt: skip
     ws = (np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts),
           np.zeros((256, 3)), np.zeros(nst))  # fmt: skip
+    proj = np.zeros((2, 8))
     count = np.zeros(nb, dtype=np.int64)
     plate_pair = np.zeros(nb, dtype=np.int64)
     fresh = np.zeros((MAX_FRESH, 2), dtype=np.int64)
@@ -515,7 +586,7 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
             break
         attempts += 1
         K[0, :] = f0
-        err = _step(y, hh, K, tab, rtol, atol_x, atol_v, model, pstate, ynew, tmp)
+        err = _step(y, hh, K, tab, rtol, atol, model, pstate, ynew, tmp)
         iout[IO_NFEV] += 12
         if not err <= 1.0:
             h = hh * (max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0)) if err > 1.0 else MIN_FACTOR)
@@ -533,7 +604,7 @@ def advance(tio, y, t_stop, rtol, atol_x, atol_v, max_steps, nodes, model, pstat
             factor = min(1.0, factor)
         rejected = False
         if k < 0:
-            _accept(t, hh, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws)
+            _accept(t, hh, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws, proj)
             t = t_bound if last else t + hh
             y[:] = ynew
             f0[:] = K[12]

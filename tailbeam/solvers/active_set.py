@@ -20,6 +20,14 @@ The fast stream solver's driver advances balls in free flight in closed form and
   equally spaced interior points of each step (dense output), contact start and end (the end
   row repeats the time of the last step end); and a log of the kinks (t, kind, pair).
 
+Optional modal plate (two-way): m mass-normalised modes (omega, zeta), state q, q' after the
+balls; each plate pair has the mode shapes phi (m,) at its contact point (fixed per contact,
+given by the caller); the plate under the ball deflects by w = phi . q, the penetration is
+r - (z - w), the ball's force F (+z) loads the modes with -phi F; constant dead loads f_dead
+(m,) on the modes. The plate gap z - w is still a polynomial on a step, so events are located
+as on the rigid plate. No residual flexibility of the truncated modes (``NOTES-modal2.md``
+measures what that costs). Without modes every result is bit-for-bit the rigid plate's.
+
 Everything in the plate frame (x downhill, z the plate normal, surface z = 0), SI units.
 Cost per step: O(balls + pairs watched). The first call compiles the kernel (cached on disk).
 """
@@ -35,6 +43,7 @@ from tailbeam.rigid.kernel import dop853_tables
 from tailbeam.solvers import active_kernel as ak
 from tailbeam.solvers.active_pairs import clamp_indicator, pair_state
 from tailbeam.solvers.cheb_events import tables as cheb_tables
+from tailbeam.solvers.modal_block import ModalBlock
 
 DEFAULT_NODES = 40  # interior force rows per step: linear interpolation < 1e-5 of the peak
 
@@ -81,8 +90,16 @@ class ActiveSet:
     (or a (P, 5) ``law_table``); gravity (3,) m/s^2 in the plate frame; half_sizes (a/2, b/2)
     m; settle_energy (n,) J (0 = never); rtol; atol_x (m), atol_v (m/s) (default rtol x 1 mm,
     rtol x 1 m/s, as the reference); max_steps per ``advance`` call; nodes_per_step: interior force
-    rows per step. Per-pair state (in/out): touching, ramp, clamped, peak (N), t_peak (s),
-    pen (m, max penetration). ``alive`` (n,): balls still integrated (False after a leave).
+    rows per step. Modal plate (optional, all m modes): omega (m,) rad/s, zeta (m,), q, qd (m,)
+    initial modal state (m sqrt(kg), m sqrt(kg)/s; default 0), phi (P, m) mode shapes at each
+    pair's contact point in 1/sqrt(kg) (rows of ball-ball pairs ignored; ``set_phi`` changes
+    a row for a new contact), f_dead (m,) constant modal forces in N/sqrt(kg) (balls resting
+    quasi-statically elsewhere); atol_q, atol_qd (default atol_x / s, atol_v / s with
+    s = max |phi| at construction, so that the deflection under a ball is held to about
+    atol_x; pass them when phi is only set later).
+    ``q``, ``qd``: views of the modal state (in/out). Per-pair state (in/out): touching, ramp,
+    clamped, peak (N), t_peak (s), pen (m, max penetration). ``alive`` (n,): balls still
+    integrated (False after a leave).
 
     For the driver: pairs overlapping at construction start touching (``open_overlapping``,
     region from the state, accumulators reset): overwrite the per-pair arrays to carry a
@@ -94,12 +111,23 @@ class ActiveSet:
 
     def __init__(self, x, v, mass, radius, pairs, laws, gravity, half_sizes, *,
                  settle_energy=None, rtol=1e-10, atol_x=None, atol_v=None, max_steps=100_000,
-                 nodes_per_step=DEFAULT_NODES, row_capacity=4096, log_capacity=256):  # fmt: skip
+                 nodes_per_step=DEFAULT_NODES, row_capacity=4096, log_capacity=256,
+                 omega=None, zeta=None, q=None, qd=None, phi=None, f_dead=None, atol_q=None,
+                 atol_qd=None):  # fmt: skip
         x = np.asarray(x, dtype=float).reshape(-1, 3)
         n = x.shape[0]
-        self.y = np.concatenate([x.ravel(), np.asarray(v, dtype=float).reshape(n, 3).ravel()])
+        npairs = np.asarray(pairs).reshape(-1, 2).shape[0]
+        modal = ModalBlock.build(npairs, omega, zeta, q, qd, phi, f_dead)
+        nm = modal.omega.shape[0]
+        self.omega, self.zeta = modal.omega, modal.zeta
+        self.phi, self.f_dead = modal.phi, modal.f_dead
+        self.y = np.concatenate(
+            [x.ravel(), np.asarray(v, dtype=float).reshape(n, 3).ravel(), modal.q, modal.qd]
+        )
         self.x = self.y[: 3 * n].reshape(n, 3)
-        self.v = self.y[3 * n :].reshape(n, 3)
+        self.v = self.y[3 * n : 6 * n].reshape(n, 3)
+        self.q = self.y[6 * n : 6 * n + nm]
+        self.qd = self.y[6 * n + nm :]
         self.mass = np.asarray(mass, dtype=float).reshape(n).copy()
         self.radius = np.asarray(radius, dtype=float).reshape(n).copy()
         pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
@@ -129,6 +157,12 @@ class ActiveSet:
         self.rtol = float(rtol)
         self.atol_x = rtol * 1e-3 if atol_x is None else float(atol_x)
         self.atol_v = rtol * 1.0 if atol_v is None else float(atol_v)
+        scale = float(np.max(np.abs(self.phi))) if self.phi.size else 1.0
+        scale = scale if scale > 0.0 else 1.0
+        atol_q = self.atol_x / scale if atol_q is None else float(atol_q)
+        atol_qd = self.atol_v / scale if atol_qd is None else float(atol_qd)
+        self.atol = np.concatenate([np.full(3 * n, self.atol_x), np.full(3 * n, self.atol_v),
+                                    np.full(nm, atol_q), np.full(nm, atol_qd)])  # fmt: skip
         self.max_steps, self.nodes = int(max_steps), int(nodes_per_step)
         self.tab = dop853_tables()
         self.tab = (self.tab[0], self.tab[1], self.tab[3], self.tab[4], self.tab[5])
@@ -155,7 +189,16 @@ class ActiveSet:
     # --- state -----------------------------------------------------------------------------
     def model(self):
         return (self.mass, self.radius, self.g, self.half, self.pi, self.pj, self.law,
-                self.rsum, self.settle_energy, self.alive)  # fmt: skip
+                self.rsum, self.settle_energy, self.alive, self.omega, self.zeta, self.phi,
+                self.f_dead)  # fmt: skip
+
+    def set_phi(self, p: int, shape):
+        """Mode shapes (m,) 1/sqrt(kg) at plate pair p's new contact point (before it touches)."""
+        self.phi[p] = np.asarray(shape, dtype=float).reshape(self.phi.shape[1])
+
+    def modal_energy(self) -> float:
+        """Kinetic + strain energy of the modes now, J: 1/2 (q'^2 + omega^2 q^2) summed."""
+        return float(0.5 * np.sum(self.qd**2 + (self.omega * self.q) ** 2))
 
     def pstate(self):
         return (self.touching, self.ramp, self.clamped, self.peak, self.t_peak, self.pen)
@@ -163,7 +206,7 @@ class ActiveSet:
     def penetration(self, p: int) -> tuple[float, float]:
         """(delta m, rate m/s) of pair p now."""
         d, rate, _, _, _ = pair_state(self.y, len(self.mass), self.pi[p], self.pj[p],
-                                      self.rsum[p])  # fmt: skip
+                                      self.rsum[p], self.phi, p)  # fmt: skip
         return float(d), float(rate)
 
     def open_overlapping(self):
@@ -196,9 +239,9 @@ class ActiveSet:
         while True:
             self.iout[ak.IO_STATUS] = -1
             ak.advance(
-                tio, self.y, float(t_stop), self.rtol, self.atol_x, self.atol_v,
-                self.max_steps, self.nodes, self.model(), self.pstate(), self.tab,
-                self.pts, self.vinv, self.rows, self.log, self.iout,
+                tio, self.y, float(t_stop), self.rtol, self.atol, self.max_steps, self.nodes,
+                self.model(), self.pstate(), self.tab, self.pts, self.vinv, self.rows, self.log,
+                self.iout,
             )  # fmt: skip
             status = int(self.iout[ak.IO_STATUS])
             if status != ak.ST_BUFFER:
