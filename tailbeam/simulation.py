@@ -46,9 +46,11 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
     how = {k: v for k, v in (("rtol", rtol), ("max_steps", max_steps)) if v is not None}
     with contextlib.nullcontext() if progress else quiet():
         if scene.needs_stream_solver:
-            result = _stream(scene, how)
-            if scene.plate_model == "modal":
-                _modal_sensors(scene, result)
+            band = _stream_band(scene) if scene.plate_model == "modal" else None
+            plate = _stream_plate(scene, band) if band and band["two_way"] else None
+            result = _stream(scene, how, plate)
+            if band:
+                _modal_sensors(scene, result, band, plate)
             return result
         if scene.plate_model == "modal":
             return _modal(scene, how)
@@ -74,7 +76,7 @@ def _modal(scene, how):
     return simulate_scene_modal(scene)
 
 
-def _stream(scene, how):
+def _stream(scene, how, plate=None):
     from tailbeam.preflight import check_streams
     from tailbeam.solvers.engine import stream_engine
 
@@ -100,37 +102,72 @@ def _stream(scene, how):
             bar.update(t - reached[0])
             reached[0] = t
 
+        extra = {} if plate is None else {"plate": plate}
         return engine.run(
             particles, scene.incline, scene.duration, laws=scene.contact, rtol=rtol,
-            max_steps=max_steps, progress=advance,
+            max_steps=max_steps, progress=advance, **extra,
         )  # fmt: skip
 
 
-def _modal_sensors(scene, result):
-    """One-way coupling of a stream on the modal plate: the stream's plate forces (rigid
-    plate contacts, ``result.loads``) drive the modes; the sensors read the plate there
-    (tailbeam.coupled.load_response). Band: plate.fmax, else the sensors' bandwidth."""
-    from tailbeam.coupled.auto import _choices, build_basis
-    from tailbeam.coupled.load_response import sensor_outputs
-    from tailbeam.coupled.loads import PlateLoads
-    from tailbeam.coupled.solver import modal_damping
+def _stream_band(scene) -> dict:
+    """The modal band of a stream scene: plate.fmax, else the sensors' bandwidth (at least
+    STREAM_MIN_BAND_HZ), and the coupling (plate.coupling: two-way by default)."""
     from tailbeam.scene import ModalPlateSettings
     from tailbeam.sensor import resolve
 
     settings = scene.modal or ModalPlateSettings()
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
     fmax = settings.fmax_hz or max(f_sensor, STREAM_MIN_BAND_HZ)
-    band = {
+    two_way = settings.coupling == "two-way"
+    return {
         "fmax_hz": float(fmax), "user_fmax": settings.fmax_hz is not None,
         "reason": "plate.fmax" if settings.fmax_hz else "the sensors' bandwidth",
         "sensor_band_covered": bool(fmax >= f_sensor), "truncation_force_error": 0.0,
-        "coupling": "one-way (stream contacts on the rigid plate drive the modes)",
+        "two_way": two_way,
+        "coupling": (
+            "two-way (the modes in the stream solver's active set; no residual flexibility "
+            "at the contacts)" if two_way
+            else "one-way (stream contacts on the rigid plate drive the modes)"
+        ),
     }  # fmt: skip
+
+
+def _basis_and_damping(scene, band):
+    from tailbeam.coupled.auto import build_basis
+    from tailbeam.coupled.solver import modal_damping
+    from tailbeam.scene import ModalPlateSettings
+
+    settings = scene.modal or ModalPlateSettings()
     basis = build_basis(scene, band)
+    return basis, modal_damping(basis.omega, settings.damping_ratio, settings.rayleigh)
+
+
+def _stream_plate(scene, band):
+    """The two-way modal plate of a stream scene (tailbeam.solvers.stream_plate)."""
+    from tailbeam.solvers.stream_plate import StreamPlate
+
+    basis, zeta = _basis_and_damping(scene, band)
+    return StreamPlate(basis, zeta)
+
+
+def _modal_sensors(scene, result, band, plate):
+    """The sensors of a stream on the modal plate: the stream's plate forces (two-way, or
+    one-way from the rigid plate: ``result.loads``) drive the modes exactly; the sensors read
+    the plate there (tailbeam.coupled.load_response)."""
+    from tailbeam.coupled.auto import _choices
+    from tailbeam.coupled.load_response import sensor_outputs
+    from tailbeam.coupled.loads import PlateLoads
+    from tailbeam.scene import ModalPlateSettings
+
+    settings = scene.modal or ModalPlateSettings()
+    if plate is None:
+        basis, zeta = _basis_and_damping(scene, band)
+    else:
+        basis, zeta = plate.basis, plate.zeta
     result.info.update(_choices(band, basis))
     note(
-        f"modal plate under a stream: one-way coupling, band 0-{fmax / 1e3:.1f} kHz "
-        f"({band['reason']}), {basis.theory}, {basis.n_modes} modes"
+        f"modal plate under a stream: {band['coupling']}, band 0-{band['fmax_hz'] / 1e3:.1f} kHz"
+        f" ({band['reason']}), {basis.theory}, {basis.n_modes} modes"
     )
     contacts, dead = result.loads
     loads = PlateLoads()
@@ -138,7 +175,6 @@ def _modal_sensors(scene, result):
         loads.add_contact(x, y, t, f)
     for x, y, t0, t1, f in dead:
         loads.add_dead_load(x, y, t0, t1, f)
-    zeta = modal_damping(basis.omega, settings.damping_ratio, settings.rayleigh)
     with task(f"sensor signals, {len(scene.sensors)} sensors, {loads.n_nodes} load nodes"):
         result.sensors = sensor_outputs(
             basis, zeta, loads, scene.sensors, scene.duration,

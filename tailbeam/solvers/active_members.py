@@ -23,8 +23,11 @@ _KIND = {"contact_start": "start", "contact_end": "end", "leave": "leave", "sett
 class ActiveMembers:
     """Members (ball numbers of ``balls``: a ``stream_state.Balls``) and their pairs."""
 
-    def __init__(self, balls, options, rtol, settle_energy):
+    def __init__(self, balls, options, rtol, settle_energy, plate=None, dead_loads=None):
         self.balls, self.options, self.rtol = balls, options, rtol
+        self.plate = plate  # a StreamPlate (two-way modal plate) or None (rigid)
+        self.dead_loads = dead_loads  # () -> (xy (p, 2), weights (p,)) of resting non-members
+        self.now = 0.0  # the driver's time (s), where a rebuilt set starts
         self.settle_energy = settle_energy  # ball number -> J
         self.members = []
         self.quiet = set()  # members resting on the plate (no SETTLE for them)
@@ -92,7 +95,7 @@ class ActiveMembers:
         self.set = ActiveSet(
             [self._x[i] for i in m], [self._v[i] for i in m], b.mass[m], b.radius[m],
             np.array(pairs, dtype=np.int64).reshape(-1, 2), law_table(laws), b.g, b.half,
-            settle_energy=np.array(settle), rtol=self.rtol,
+            settle_energy=np.array(settle), rtol=self.rtol, **self._modal_inputs(m),
         )  # fmt: skip
         self.index = {k: p for p, k in enumerate(self.keys)}
         s = self.set
@@ -103,6 +106,40 @@ class ActiveMembers:
         self.local = local
         self.dirty = False
         self.totals["rebuilds"] += 1
+
+    def _modal_inputs(self, members) -> dict:
+        """The modal block of a rebuilt set: the plate's state now, the mode shapes under
+        each member (rows of ball-ball pairs stay 0), the dead loads of resting non-members;
+        resting members sit at their static penetration on the deflected plate."""
+        plate = self.plate
+        if plate is None:
+            return {}
+        plate.propagate(self.now)
+        plate.set_dead_loads(*self.dead_loads())
+        shapes = plate.shapes(np.array([self._x[i][:2] for i in members]).reshape(-1, 2))
+        phi = np.zeros((len(self.keys), plate.n_modes))
+        for q in range(len(members)):
+            phi[q] = shapes[q]  # the plate pairs come first, in member order
+        for q, i in enumerate(members):
+            if i in self.quiet:
+                self._x[i][2] = self.balls.radius[i] - self.balls.static_pen[i] + phi[q] @ plate.q
+        atol_x = self.rtol * 1e-3
+        scale = float(np.max(plate.phi_max))
+        return dict(
+            omega=plate.omega, zeta=plate.zeta, q=plate.q, qd=plate.qd, phi=phi,
+            f_dead=plate.f_dead, atol_q=atol_x / scale, atol_qd=self.rtol / scale,
+        )  # fmt: skip
+
+    def refresh_shapes(self):
+        """Modal plate: the mode shapes of every plate pair not touching, at its ball's
+        position now (a touching pair keeps those of its contact point)."""
+        if self.plate is None or not self.members:
+            return
+        s = self._ready()
+        for q, i in enumerate(self.members):
+            p = self.index[(i, -1)]
+            if not s.touching[p]:
+                s.set_phi(p, self.plate.shapes(s.x[q, :2])[0])
 
     def _count(self):
         if self.set is not None:
@@ -126,6 +163,8 @@ class ActiveMembers:
         out = s.advance(t, t_stop, self.h or None)
         self.h = s.h
         self._drain()
+        if self.plate is not None:
+            self.plate.take(s.q, s.qd, out.t)
         kind = _KIND.get(out.kind)
         if kind is None:
             return None, None, out.t
@@ -160,6 +199,8 @@ class ActiveMembers:
         t = np.concatenate(entry[2])
         f = np.concatenate(entry[3])
         order = np.argsort(t, kind="stable")
+        if not t[order[-1]] > t[order[0]]:
+            return None  # a single instant (a contact flushed as it started): no load
         return entry[0], entry[1], t[order], f[order]
 
     # --- state ----------------------------------------------------------------------------------
@@ -232,8 +273,9 @@ class ActiveMembers:
         removed = float(settle_excess(s.y, s.model(), p, q)) if s.touching[p] else 0.0
         if not s.touching[p]:  # a slow rebound: the energy of the normal motion above rest
             removed = 0.5 * s.mass[q] * s.v[q, 2] ** 2
-        s.x[q, 2] = self.balls.radius[i] - self.balls.static_pen[i]
-        s.v[q, 2] = 0.0
+        w, wd = (s.phi[p] @ s.q, s.phi[p] @ s.qd) if self.plate is not None else (0.0, 0.0)
+        s.x[q, 2] = self.balls.radius[i] - self.balls.static_pen[i] + w
+        s.v[q, 2] = wd
         law = s.law[p]
         s.touching[p] = True
         s.ramp[p] = self.balls.static_pen[i] < law[3] or law[2] <= 0.0

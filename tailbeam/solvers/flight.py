@@ -93,6 +93,22 @@ def plate_time(z0: float, vz: float, az: float, radius: float) -> float:
     return (vz + root) / gn
 
 
+def band_time(z0: float, vz: float, az: float, height: float) -> float:
+    """Time (s) until a flying ball's centre comes down to ``height`` (m) above the plate
+    (z may start below it: then the descending crossing), or inf if its apex stays below."""
+    gn = -az
+    gap = z0 - height
+    if gn <= 0.0:
+        return max(gap, 0.0) / -vz if vz < 0.0 else NEVER
+    disc = vz * vz + 2.0 * gn * gap
+    if disc < 0.0:
+        return NEVER
+    root = math.sqrt(disc)
+    if gap >= 0.0 and vz <= 0.0:
+        return 2.0 * gap / (root - vz) if root - vz > 0.0 else 0.0
+    return (vz + root) / gn
+
+
 def _exit_time(room: float, rate: float, accel: float) -> float:
     """First tau > 0 where room - rate tau - accel tau^2 / 2 = 0, room >= 0 (m), or inf."""
     room = max(room, 0.0)

@@ -47,6 +47,7 @@ MAX_PARTICLES = 200_000  # per scene: memory ~40 kB per particle (records, force
 SET_HORIZON = 1e-3  # s: the active set looks this far ahead for balls that could reach it
 RELEASE_RETRY = 1e-3  # s: a particle that would overlap a ball at its release waits this long
 REST_CONTACT_FACTOR = 50.0  # a plate contact longer than this many Hertz durations is at rest
+SHAPE_TRAVEL = 1e-3  # m: modal plate: mode shapes refreshed after this much lateral travel
 # heap event kinds (the order breaks ties at equal times: releases first)
 _RELEASE, _EPOCH, _PLATE, _PAIR, _EDGE = range(5)
 
@@ -69,6 +70,7 @@ class StreamRun:
 def simulate_stream(
     particles, incline: InclinedPlate, duration: float, *, laws, rtol: float = DEFAULT_RTOL,
     max_steps: int = DEFAULT_MAX_STEPS, progress=True, rest_speed: float = DEFAULT_REST_SPEED,
+    plate=None,
 ):  # fmt: skip
     """The stream solver as ``tailbeam.solvers.engine`` calls it: a ``StreamResult``.
 
@@ -80,7 +82,7 @@ def simulate_stream(
     run = solve_stream(
         particles, incline, duration, damping=laws.damping, penetration=laws.penetration,
         clamp=laws.clamp, exponent=laws.exponent, rtol=rtol, rest_speed=rest_speed,
-        max_work=max_steps, progress=progress,
+        max_work=max_steps, progress=progress, plate=plate,
     )  # fmt: skip
     result = StreamResult(
         run.particles, run.contacts, run.leaves, run.events, incline, duration,
@@ -111,19 +113,21 @@ def solve_stream(
     rest_speed: float = DEFAULT_REST_SPEED,
     max_work: int = DEFAULT_MAX_STEPS,
     progress=True,
+    plate=None,
 ) -> StreamRun:
     """Simulate ``particles`` (``tailbeam.streams.generator.Particle``: released at their
     t_release with their position and velocity, plate frame) on ``incline`` for ``duration``
     s. IMPACT parameters shared by every pair (stiffness from Hertz for each pair); rtol: the
     kernel's relative tolerance; rest_speed (m/s): see the module docstring; max_work: bound
-    on kernel steps plus events (WorkLimitError beyond)."""
+    on kernel steps plus events (WorkLimitError beyond); plate: a ``StreamPlate`` (the modal
+    plate, two-way) or None (the rigid plate)."""
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-4:
         raise InputError("rtol", f"must lie in [1e-14, 1e-4], got {rtol!r}")
     if rest_speed < 0:
         raise InputError("rest_speed", f"must be >= 0, got {rest_speed!r}")
     options = LawOptions(exponent, damping, penetration, clamp)
-    sim = _Stream(particles, incline, duration, options, rtol, rest_speed, max_work)
+    sim = _Stream(particles, incline, duration, options, rtol, rest_speed, max_work, plate)
     label = f"simulating {duration:g} s, {len(sim.balls.names)} particles"
     with contextlib.ExitStack() as stack:
         if callable(progress):
@@ -149,13 +153,18 @@ class _CallbackBar:
 class _Stream:
     """The event loop; see the module docstring."""
 
-    def __init__(self, particles, incline, duration, options, rtol, rest_speed, max_events):
+    def __init__(self, particles, incline, duration, options, rtol, rest_speed, max_events, plate):
         from tailbeam.solvers.active_members import ActiveMembers
 
         self.balls = Balls(particles, incline, options)
         self.incline, self.duration, self.options = incline, duration, options
         self.rest_speed, self.max_events = rest_speed, max_events
-        self.act = ActiveMembers(self.balls, options, rtol, self._settle_energy)
+        self.plate = plate
+        self.act = ActiveMembers(
+            self.balls, options, rtol, self._settle_energy, plate, self._resting_outside
+        )
+        self.landing = set()  # modal plate: balls within the deflection bound, touching nothing
+        self.w_margin = 0.0  # modal plate: plate touches are predicted this far above it
         self.heap, self.seq, self.t, self.loops = [], 0, 0.0, 0
         self.epoch_end, self.set_end = 0.0, 0.0
         self.core = set()
@@ -215,7 +224,7 @@ class _Stream:
             target = min(t_next, self.duration)
             if self.act.members and self._advance_set(target):
                 continue
-            self.t = target
+            self.t = self.act.now = target
             if self.t - shown > 1e-3:
                 bar.update(1e3 * (self.t - shown))
                 shown = self.t
@@ -247,7 +256,8 @@ class _Stream:
         stop = min(target, self.set_end)
         kind, key, t_new = self.act.advance(self.t, stop)
         self.stats["set_calls"] += 1
-        self.t = t_new
+        self.t = self.act.now = t_new
+        self._check_margin()
         self._log_kinks()
         if kind is not None:
             self.stats["set_events"] += 1
@@ -277,7 +287,13 @@ class _Stream:
         elif kind == _EPOCH:
             self._new_epoch()
         elif kind == _PLATE and b.status[i] == FLY and not b.in_set[i]:
-            self._join([i], t, (i, -1))
+            if self.plate is None:
+                self._join([i], t, (i, -1))
+            else:  # near the vibrating plate: the integrator finds the real start
+                self._absorb(i)
+                self.landing.add(i)
+                self._make_core(i)
+                self._refresh_set()
         elif kind == _PAIR and not (b.in_set[i] and b.in_set[j]):
             if b.status[i] in (FLY, SLIDE) and b.status[j] in (FLY, SLIDE):
                 self._join([i, j], t, (min(i, j), max(i, j)))
@@ -337,7 +353,7 @@ class _Stream:
     def _predict(self, i: int):
         """Own events of closed-form ball i, and its touches with the other closed-form
         balls within the epoch."""
-        for t_ev, what, edge in self.balls.own_events(i, self.t):
+        for t_ev, what, edge in self.balls.own_events(i, self.t, self.w_margin):
             self.push(t_ev, _PLATE if what == "plate" else _EDGE, i, edge=edge)
         self._predict_pairs(i)
 
@@ -385,6 +401,7 @@ class _Stream:
 
     # --- events of the active set -------------------------------------------------------------
     def _on_start(self, key):
+        self.landing.discard(key[0])
         self._open(key)
         for k in key:
             if k >= 0:
@@ -398,7 +415,8 @@ class _Stream:
             self._close(key, "separated")
             return
         others = [p for p in self.act.touching_pairs(i) if p != key]
-        slow = self.act.state(i)[1][2] < self.rest_speed and self.balls.g[2] < 0.0
+        v_out = self.act.state(i)[1][2]
+        slow = 0.0 <= v_out < self.rest_speed and self.balls.g[2] < 0.0
         self._close(key, "rest" if slow and not others else "separated")
         self._flush_nodes(i)
         if slow and not others:
@@ -421,6 +439,7 @@ class _Stream:
         b.status[i] = GONE
         b.version[i] += 1
         self.core.discard(i)
+        self.landing.discard(i)
         self.leaves.append(LeaveEvent(b.names[i], self.t, edge))
         self.events.append((self.t, EventKind.LEAVE, b.names[i], edge))
 
@@ -433,6 +452,8 @@ class _Stream:
                 self._on_settle(i)
 
     def _is_core(self, i: int) -> bool:
+        if i in self.landing:
+            return True
         return any(key in self.open for key in self.act.touching_pairs(i))
 
     def _make_core(self, i: int):
@@ -463,24 +484,71 @@ class _Stream:
         b = self.balls
         if self.t == b.t_release[i]:
             return
-        depth = b.radius[i] - x[2] if b.status[i] == FLY else 0.0
+        depth = b.radius[i] - (x[2] - self._plate_deflection(x)) if b.status[i] == FLY else 0.0
+        what = "plate"
         if self.act.members:
             m = np.array(self.act.members)
             d = np.linalg.norm(self.act.positions(m) - x, axis=1)
-            depth = max(depth, float(np.max(b.radius[m] + b.radius[i] - d)))
+            overlap = b.radius[m] + b.radius[i] - d
+            if overlap.max() > depth:
+                depth, what = float(overlap.max()), b.names[int(m[np.argmax(overlap)])]
         if depth > 1e-12:
             self.stats["late_starts"] += 1
+            log = self.stats.setdefault("late_start_log", [])
+            if len(log) < 10:
+                log.append((self.t, b.names[i], what, depth))
+
+    def _plate_deflection(self, x) -> float:
+        """The modal plate's deflection (m) under the point x now (0 for the rigid plate)."""
+        if self.plate is None:
+            return 0.0
+        self.plate.propagate(self.t)
+        return float(self.plate.shapes(x[:2])[0] @ self.plate.q)
 
     def _release_from_core(self, i: int):
         """Core ball i touches nothing any more (or only rests on the plate): closed form."""
         b = self.balls
         x, v = self.act.state(i)
         quiet = (i, -1) in self.act.touching_pairs(i)
+        if not quiet and self.plate is not None and self._stays_near_plate(i, x, v):
+            self.landing.add(i)  # it comes back within the plate's deflection bound
+            return
         b.set_motion(i, SLIDE if quiet else FLY, self.t, x, v)
         if quiet:
             b.slide_since[i] = self.t
         self.core.discard(i)
         self._predict(i)
+
+    def _stays_near_plate(self, i: int, x, v) -> bool:
+        """Modal plate: does ball i's flight keep it within the margin above the plate?"""
+        gn = -self.balls.g[2]
+        apex = x[2] + (v[2] ** 2 / (2.0 * gn) if v[2] > 0.0 and gn > 0.0 else 0.0)
+        return apex < self.balls.radius[i] + self.w_margin
+
+    def _check_margin(self):
+        """Modal plate: keep the plate-touch predictions above the plate's deflection bound;
+        when it has grown past the margin, double the margin and predict again."""
+        if self.plate is None:
+            return
+        bound = self.plate.deflection_bound()
+        if bound <= self.w_margin:
+            return
+        self.w_margin = max(2.0 * bound, 1e-9)
+        self.stats["margin_updates"] = self.stats.get("margin_updates", 0) + 1
+        b = self.balls
+        for i in np.flatnonzero((b.status == FLY) & ~b.in_set):
+            for t_ev, what, _edge in b.own_events(int(i), self.t, self.w_margin):
+                if what == "plate":
+                    self.push(t_ev, _PLATE, int(i))
+
+    def _resting_outside(self):
+        """(xy (p, 2) m, weights (p,) N) of the balls resting on the plate outside the set."""
+        b = self.balls
+        idx = np.flatnonzero((b.status == SLIDE) & ~b.in_set)
+        if not len(idx):
+            return np.empty((0, 2)), np.empty(0)
+        x, _ = b.states(idx, self.t)
+        return x[:, :2], b.mass[idx] * -b.g[2]
 
     def _exit(self, i: int):
         b = self.balls
@@ -507,6 +575,12 @@ class _Stream:
             return
         h = SET_HORIZON
         self.set_end = min([t + h] + [self.limit[i] for i in core if i in self.limit])
+        if self.plate is not None:  # mode shapes where the landing balls will touch
+            self.act.refresh_shapes()
+            for i in self.landing:
+                lateral = float(np.hypot(*self.act.state(i)[1][:2]))
+                if lateral > 0.0:
+                    self.set_end = min(self.set_end, t + SHAPE_TRAVEL / lateral)
         xc = self.act.positions(core)
         # energy a core ball can receive: the core's kinetic and elastic energy, plus what
         # gravity can give in h (a 1 cm drop of every core ball: far more than they fall)
@@ -626,6 +700,9 @@ class _Stream:
         b = self.balls
         self.t = self.duration
         self.stats["energy_final"] = self._final_energy()
+        if self.plate is not None:
+            self.plate.propagate(self.duration)
+            self.stats["energy_plate_final"] = self.plate.energy()
         for key in list(self.open):
             recs = self.open.pop(key)
             peak, t_peak, pen = self.act.accumulators(key)

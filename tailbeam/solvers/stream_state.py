@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tailbeam.contact_law import ball_plate_law
-from tailbeam.solvers.flight import advance, edge_time, pair_time, plate_time
+from tailbeam.solvers.flight import advance, band_time, edge_time, pair_time, plate_time
 
 PENDING, FLY, SLIDE, ACTIVE, GONE = range(5)
 
@@ -101,13 +101,17 @@ class Balls:
         acc = np.where(self.status[idx] == SLIDE, abs(self.g_slide[0]), np.linalg.norm(self.g))
         return np.linalg.norm(v, axis=1) + acc * horizon
 
-    def own_events(self, i: int, t: float) -> list:
-        """(time, kind, edge) of the plate touch (FLY) and the edge crossing of ball i."""
+    def own_events(self, i: int, t: float, margin: float = 0.0) -> list:
+        """(time, kind, edge) of the plate touch (FLY; with a margin (m) above the plate: the
+        vibrating plate's deflection bound) and the edge crossing of ball i."""
         x, v = self.state(i, t)
         a = self.accel(i)
         out = []
         if self.status[i] == FLY:
-            tau = plate_time(x[2], v[2], a[2], self.radius[i])
+            if margin > 0.0:
+                tau = band_time(x[2], v[2], a[2], self.radius[i] + margin)
+            else:
+                tau = plate_time(x[2], v[2], a[2], self.radius[i])
             if math.isfinite(tau):
                 out.append((t + tau, "plate", ""))
         tau, edge = edge_time(x, v, a, self.half)
