@@ -106,6 +106,23 @@ def _stream(scene, how):
         )  # fmt: skip
 
 
+def stream_band(scene) -> dict:
+    """The modal band of a stream scene on the modal plate (one-way coupling): plate.fmax,
+    else the sensors' bandwidth, at least STREAM_MIN_BAND_HZ; a dict as choose_band's."""
+    from tailbeam.scene import ModalPlateSettings
+    from tailbeam.sensor import resolve
+
+    settings = scene.modal or ModalPlateSettings()
+    f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
+    fmax = settings.fmax_hz or max(f_sensor, STREAM_MIN_BAND_HZ)
+    return {
+        "fmax_hz": float(fmax), "user_fmax": settings.fmax_hz is not None,
+        "reason": "plate.fmax" if settings.fmax_hz else "the sensors' bandwidth",
+        "sensor_band_covered": bool(fmax >= f_sensor), "truncation_force_error": 0.0,
+        "coupling": "one-way (stream contacts on the rigid plate drive the modes)",
+    }  # fmt: skip
+
+
 def _modal_sensors(scene, result):
     """One-way coupling of a stream on the modal plate: the stream's plate forces (rigid
     plate contacts, ``result.loads``) drive the modes; the sensors read the plate there
@@ -115,17 +132,10 @@ def _modal_sensors(scene, result):
     from tailbeam.coupled.loads import PlateLoads
     from tailbeam.coupled.solver import modal_damping
     from tailbeam.scene import ModalPlateSettings
-    from tailbeam.sensor import resolve
 
     settings = scene.modal or ModalPlateSettings()
-    f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
-    fmax = settings.fmax_hz or max(f_sensor, STREAM_MIN_BAND_HZ)
-    band = {
-        "fmax_hz": float(fmax), "user_fmax": settings.fmax_hz is not None,
-        "reason": "plate.fmax" if settings.fmax_hz else "the sensors' bandwidth",
-        "sensor_band_covered": bool(fmax >= f_sensor), "truncation_force_error": 0.0,
-        "coupling": "one-way (stream contacts on the rigid plate drive the modes)",
-    }  # fmt: skip
+    band = stream_band(scene)
+    fmax = band["fmax_hz"]
     basis = build_basis(scene, band)
     result.info.update(_choices(band, basis))
     note(
