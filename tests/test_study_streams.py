@@ -2,7 +2,8 @@
 dataset's labels agree with the scene and with a direct simulation of each case (gangue
 fraction = the swept value, particle counts = the scene's particles, coal and gangue plate
 impacts = impacts_table's rows), the signals are the direct simulation's, repeats draw
-independent particles, and the fixed-window features of study 2 exist."""
+independent particles, and the fixed-window features of study 2 and the impact windows (plate
+rows only) exist."""
 
 from pathlib import Path
 
@@ -119,6 +120,12 @@ def test_stream_sweep_labels_match_the_scene(tmp_path, scheduler, capsys):
     assert len(feats) == 3 * ds.sizes["case"]  # three 0.1 s windows per 0.3 s case
     assert np.isfinite(feats["S1.rms"]).all() and (feats["S1.rms"] > 0).all()
     np.testing.assert_array_equal(feats["gangue_fraction"], feats["streams.cave.gangue_fraction"])
+    # impact windows: one per plate row whose 20 ms window (from 0.5 ms before) fits the record
+    per_impact = feature_table(out, window="impact", length=0.02, pre=0.0005)
+    plate = impacts[impacts["partner"] == "plate"]
+    start = np.clip(np.round((plate["t_start"] - 0.0005) * 8000.0), 0, None)
+    assert len(per_impact) == int(np.sum(start + 160 <= ds.sizes["time"])) > 0
+    assert set(per_impact["label"]) == {"coal", "gangue"}
 
 
 def test_stream_repeats_draw_independent_particles(tmp_path):
