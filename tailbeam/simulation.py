@@ -46,7 +46,7 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
     how = {k: v for k, v in (("rtol", rtol), ("max_steps", max_steps)) if v is not None}
     with contextlib.nullcontext() if progress else quiet():
         if scene.needs_stream_solver:
-            band = _stream_band(scene) if scene.plate_model == "modal" else None
+            band = stream_band(scene) if scene.plate_model == "modal" else None
             plate = _stream_plate(scene, band) if band and band["two_way"] else None
             result = _stream(scene, how, plate)
             if band:
@@ -109,7 +109,7 @@ def _stream(scene, how, plate=None):
         )  # fmt: skip
 
 
-def _stream_band(scene) -> dict:
+def stream_band(scene) -> dict:
     """The modal band of a stream scene: plate.fmax, else the sensors' bandwidth (at least
     STREAM_MIN_BAND_HZ), and the coupling (plate.coupling: two-way by default)."""
     from tailbeam.scene import ModalPlateSettings

@@ -59,10 +59,13 @@ def test_sensor_placement_study_quick(tmp_path, client):
     assert all(r["n_cases"] == 12 for r in rows)
 
 
-def test_gangue_fraction_proxy_quick(tmp_path, client):
-    module = _load("study_gangue_fraction_proxy")
+def test_stream_gangue_fraction_study_quick(tmp_path, client):
+    module = _load("study_stream_gangue_fraction")
     rows = module.main(quick=True, out=tmp_path, client=client)
-    assert [r["snr_db"] for r in rows] == [math.inf, 20.0]
-    assert rows[0]["n_cases"] == 6
-    assert 0.0 <= rows[0]["fraction_min"] <= rows[0]["fraction_max"] <= 1.0
-    assert rows[0]["mae"] >= 0.0
+    assert [r["snr_db"] for r in rows] == [math.inf, 0.0]
+    assert rows[1]["noise_rms"] == pytest.approx(rows[1]["reference_rms"])  # 0 dB
+    assert rows[0]["n_cases"] == 6 and rows[0]["n_rows"] == 12  # two windows after the first
+    assert 0.0 <= rows[0]["fraction_min"] <= rows[0]["fraction_max"] <= 0.5
+    assert all(r["mae"] >= 0.0 and r["count_reference_mae"] >= 0.0 for r in rows)
+    assert (tmp_path / "gangue_fraction_vs_snr.csv").is_file()
+    assert module.visualize(rows, tmp_path / "f.png").stat().st_size > 0

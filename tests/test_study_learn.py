@@ -100,3 +100,10 @@ def test_undefined_features_are_imputed_not_dropped():
     table["label"] = np.where(table["S1.rms"] > 0, "gangue", "coal")
     scores = learn(table, "label", folds=3)
     assert scores["n_rows"] == 30 and np.sum(scores["confusion"]) == 30
+
+
+def test_mae_standard_error_counts_cases_not_windows():
+    from tailbeam.study.learn import _case_se
+
+    # two windows per case; per-case means 1 and 3: std sqrt(2), over sqrt(2 cases) = 1
+    assert _case_se(np.array([1.0, 1.0, 3.0, 3.0]), np.array([0, 0, 1, 1])) == pytest.approx(1.0)

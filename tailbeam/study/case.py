@@ -19,14 +19,10 @@ from tailbeam.results_io import IMPACT_COLUMNS
 def basis_signature(scene) -> str:
     """A key shared by the cases that use the same modal basis (plate, boundary, theory, mesh,
     band): a sweep warms the cache once per key before its cases run."""
-    from tailbeam.coupled.auto import choose_band
-
     m = scene.modal
     p = scene.plate
     mat = p.material
-    # the band choose_band would give: the scene's plate.fmax when set (then the contact
-    # pulses it also estimates, ~5 ms per case, are not needed here)
-    fmax = m.fmax_hz if m.fmax_hz is not None else choose_band(scene, m)["fmax_hz"]
+    fmax = _band(scene)["fmax_hz"]
     return json.dumps(
         [
             [p.size_x, p.size_y, p.thickness],
@@ -39,15 +35,32 @@ def basis_signature(scene) -> str:
     )
 
 
+def _band(scene) -> dict:
+    """The band the scene's solver will use: a stream scene's (tailbeam.simulation), else
+    the scene's plate.fmax when set (then the contact pulses choose_band also estimates,
+    ~5 ms per case, are not needed here), else choose_band's."""
+    from tailbeam.coupled.auto import choose_band
+    from tailbeam.simulation import stream_band
+
+    if scene.needs_stream_solver:
+        return stream_band(scene)
+    if scene.modal.fmax_hz is not None:
+        return {"fmax_hz": scene.modal.fmax_hz}
+    return choose_band(scene, scene.modal)
+
+
 def warm_basis(scene_toml: str) -> str:
     """Compute (or load) the modal basis of the scene into the on-disk cache; returns the
     basis description. Runs once per basis_signature before the sweep's cases."""
     from tailbeam.coupled.auto import build_basis
     from tailbeam.scene_file import loads_scene
+    from tailbeam.simulation import stream_band
 
     try:
+        scene = loads_scene(scene_toml)
+        band = stream_band(scene) if scene.needs_stream_solver else None
         with quiet():  # a worker's notes and bars would interleave on the user's terminal
-            basis = build_basis(loads_scene(scene_toml))
+            basis = build_basis(scene, band)
     except Exception as err:  # noqa: BLE001 - the cases then fail with their own error
         return f"basis not cached: {_one_line(err)}"
     return f"{basis.theory} {basis.boundary}, {basis.n_modes} modes"
@@ -69,20 +82,46 @@ def _impact_rows(result, coal: tuple) -> list:
     return rows
 
 
+def _stream_rows(result) -> list:
+    """impacts_table() of a StreamResult as row dicts (every stream column), plus ``class``
+    (= the striking particle's ``label``: the stream decides what is gangue)."""
+    table = result.impacts_table()
+    names = list(table)
+    rows = [dict(zip(names, values, strict=True)) for values in zip(*table.values(), strict=True)]
+    for row in rows:
+        row["class"] = row["label"]
+    return [{k: v.item() if isinstance(v, np.generic) else v for k, v in r.items()} for r in rows]
+
+
+def _counts(rows: list, stream: bool) -> dict:
+    """Coal and gangue impacts on the plate (a stream's ball-ball rows are not plate
+    impacts) and, for streams, the number of ball-ball contacts (each gives two rows)."""
+    plate = [r for r in rows if not stream or r["partner"] == "plate"]
+    classes = [r["class"] for r in plate]
+    out = {"n_coal_impacts": classes.count("coal"), "n_gangue_impacts": classes.count("gangue")}
+    if stream:
+        out["n_ball_contacts"] = (len(rows) - len(plate)) // 2
+    return out
+
+
 def run_case(scene_toml: str, coal: tuple, *_after) -> dict:
     """Simulate one case. Returns {"status": "ok" | "failed", "error", "wall_time",
     "cpu_time" (s, this process),
     "signals": {sensor: float32 array m/s^2}, "impacts": [row dicts], "n_coal_impacts",
-    "n_gangue_impacts"}. ``_after`` are ignored (Dask dependencies, e.g. the warmed basis)."""
+    "n_gangue_impacts" (plate impacts), and for a stream scene "n_ball_contacts"}.
+    ``_after`` are ignored (Dask dependencies, e.g. the warmed basis)."""
     from tailbeam.commands.simulate import solve
     from tailbeam.scene_file import loads_scene
 
     t0 = time.perf_counter()
     c0 = time.process_time()
     out = {"status": "failed", "error": "", "signals": {}, "impacts": []}
+    stream = False
     try:
         with quiet():  # the sweep's own bar reports progress; per-case notes would flood it
-            result = solve(loads_scene(scene_toml))
+            scene = loads_scene(scene_toml)
+            stream = scene.needs_stream_solver
+            result = solve(scene)
         if result.status != 0:
             out["error"] = f"solver stopped: {result.message}".splitlines()[0]
         else:
@@ -90,13 +129,11 @@ def run_case(scene_toml: str, coal: tuple, *_after) -> dict:
                 name: np.asarray(a, dtype=np.float32)
                 for name, (_t, a) in result.sensor_signals.items()
             }
-            out["impacts"] = _impact_rows(result, coal)
+            out["impacts"] = _stream_rows(result) if stream else _impact_rows(result, coal)
             out["status"] = "ok"
     except Exception as err:  # noqa: BLE001 - any failure is recorded, never raised
         out["error"] = _one_line(err) or traceback.format_exc().splitlines()[-1]
-    classes = [r["class"] for r in out["impacts"]]
-    out["n_coal_impacts"] = classes.count("coal")
-    out["n_gangue_impacts"] = classes.count("gangue")
+    out.update(_counts(out["impacts"], stream))
     out["wall_time"] = time.perf_counter() - t0
     out["cpu_time"] = time.process_time() - c0
     return out

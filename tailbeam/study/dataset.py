@@ -3,7 +3,8 @@
 - ``dataset.zarr``: an xarray Dataset (Zarr v3). ``acceleration`` (case, sensor, time) float32
   in m/s^2 as each sensor recorded it (chain and noise included); coordinates of ``case``: the
   case hash, seed, repeat, labels (``label``, ``gangue_fraction``, ``n_coal``, ``n_gangue``,
-  ``n_coal_impacts``, ``n_gangue_impacts``) and every swept value (vector values one
+  ``n_coal_impacts``, ``n_gangue_impacts``; for stream scenes also ``gangue_mass_fraction``,
+  ``n_particles``, ``n_ball_contacts``) and every swept value (vector values one
   coordinate per component, ``key[i]``); ``sensor_x``, ``sensor_y`` (case, sensor) in m.
   Attributes: units, sample rate (Hz), duration (s), the base sensor positions, the tailbeam
   version, the sweep file, and ``case_scenes`` (case hash -> the case's scene TOML).
@@ -37,6 +38,9 @@ LABEL_COLUMNS = (
     "n_coal_impacts",
     "n_gangue_impacts",
 )
+# labels of stream scenes only (tailbeam.study.design.stream_labels, tailbeam.study.case)
+STREAM_LABEL_COLUMNS = ("gangue_mass_fraction", "n_particles")
+STREAM_RESULT_COLUMNS = ("n_ball_contacts",)
 LEDGER_COLUMNS = (
     "case",
     "case_hash",
@@ -163,6 +167,7 @@ class DatasetStore:
                 **case.labels,
                 "n_coal_impacts": result["n_coal_impacts"],
                 "n_gangue_impacts": result["n_gangue_impacts"],
+                **{k: result[k] for k in STREAM_RESULT_COLUMNS if k in result},
                 **flat_params(case.params),
             }
             rows.append(row)

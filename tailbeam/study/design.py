@@ -21,8 +21,10 @@ vector. Grid axes form a product; random axes (``uniform``, ``loguniform``, ``ch
 one ``samples`` count and are drawn afresh for every grid point; ``follow`` sets a key to
 ``scale * value + offset`` of another swept key. Draws and case seeds are hashed from the seed
 and the case's own values, so a grown sweep (more values, samples or repeats) keeps the cases
-it had. Every sensor's noise seed is set to the case seed. Each case is the scene TOML
-(``dumps_scene``) plus a ``# case seed`` line; its SHA-256 is the case's key.
+it had. Every sensor's noise seed is set to the case seed, and every stream's seed to one
+drawn from it (unless ``streams.NAME.seed`` is swept), so repeats are independent. Each case
+is the scene TOML (``dumps_scene``) plus a ``# case seed`` line; its SHA-256 is the case's
+key. A stream is addressed by its name: ``streams.NAME.gangue_fraction``.
 """
 
 import copy
@@ -314,7 +316,9 @@ def _plain(v):
 
 def case_labels(scene, coal: tuple) -> dict:
     """Labels of a scene: class of the balls ("coal", "gangue" or "mixed"), gangue mass
-    fraction, numbers of coal and gangue balls."""
+    fraction, numbers of coal and gangue balls (stream scenes: stream_labels)."""
+    if scene.streams:
+        return stream_labels(scene)
     is_coal = [b.material.name in coal for b in scene.balls]
     mass = sum(b.mass for b in scene.balls)
     gangue_mass = sum(b.mass for b, c in zip(scene.balls, is_coal, strict=True) if not c)
@@ -327,6 +331,42 @@ def case_labels(scene, coal: tuple) -> dict:
         "n_coal": n_coal,
         "n_gangue": n_gangue,
     }
+
+
+def stream_labels(scene) -> dict:
+    """Labels of a scene with streams, from its particles (each labelled coal or gangue by
+    its stream, [[balls]] by their label): ``label`` (coal, gangue or mixed), ``gangue_fraction``
+    = the streams' declared gangue_fraction (the probability that a particle is gangue;
+    several streams: weighted by their expected particle counts; [[balls]] not included),
+    ``gangue_mass_fraction`` (realised, by mass, all particles released before the end),
+    ``n_coal``, ``n_gangue``, ``n_particles`` (particles, [[balls]] included)."""
+    parts = scene.particles
+    gangue = [p for p in parts if p.label == "gangue"]
+    expected = [max(n, 0.0) for n in scene.expected_particles()]
+    declared = sum(n * s.gangue_fraction for n, s in zip(expected, scene.streams, strict=True))
+    mass = sum(p.mass for p in parts)
+    n_gangue = len(gangue)
+    n_coal = len(parts) - n_gangue
+    return {
+        "label": "mixed" if n_coal and n_gangue else ("gangue" if n_gangue else "coal"),
+        "gangue_fraction": declared / sum(expected) if sum(expected) > 0 else math.nan,
+        "n_coal": n_coal,
+        "n_gangue": n_gangue,
+        "gangue_mass_fraction": sum(p.mass for p in gangue) / mass if mass > 0 else math.nan,
+        "n_particles": len(parts),
+    }
+
+
+def _seed_streams(data: dict, seed: int, params: dict) -> None:
+    """Give every stream a seed drawn from the case seed (so repeats and design points draw
+    independent particles), unless its seed is a swept axis."""
+    streams = data.get("streams")
+    for i, stream in enumerate(streams if isinstance(streams, list) else [], start=1):
+        if not isinstance(stream, dict):
+            continue
+        keys = {f"streams[{i}].seed", f"streams.{stream.get('name')}.seed"}
+        if not keys & set(params):
+            stream["seed"] = _hash_int(seed, "stream", i)
 
 
 def _seed_noise(data: dict, seed: int) -> None:
@@ -347,6 +387,7 @@ def make_case(spec: SweepSpec, params: dict, repeat: int, number: int):
     for key, value in params.items():
         set_value(data, key, value)
     _seed_noise(data, seed)
+    _seed_streams(data, seed, params)
     shown = ", ".join(f"{k} = {v!r}" for k, v in params.items())
     try:
         scene = parse_scene(data)

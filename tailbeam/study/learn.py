@@ -52,7 +52,8 @@ def learn(table, target="label", *, folds=5, seed=0, sensors=None) -> dict:
 
     Returns a dict: target, n_rows, n_cases, folds, features, and for a label "accuracy",
     "f1_macro", "classes", "confusion" (rows true, columns predicted), or for gangue_fraction
-    "mae", "r2"; "dummy" holds the dummy's scores; "importances" feature -> importance."""
+    "mae", "r2", "mae_se" (standard error of the MAE, cases as the units); "dummy" holds the
+    dummy's scores; "importances" feature -> importance."""
     from sklearn import metrics
     from sklearn.model_selection import GroupKFold, cross_val_predict
 
@@ -88,8 +89,9 @@ def learn(table, target="label", *, folds=5, seed=0, sensors=None) -> dict:
         out["dummy"] = _class_scores(metrics, y, floor, classes)
         out["dummy"].pop("confusion")
     else:
-        out.update(_reg_scores(metrics, y, pred))
+        out.update(_reg_scores(metrics, y, pred), mae_se=_case_se(np.abs(pred - y), groups))
         out["dummy"] = _reg_scores(metrics, y, floor)
+        out["dummy"]["mae_se"] = _case_se(np.abs(floor - y), groups)
     forest = _model(classify, seed).fit(x, y)[-1]
     order = np.argsort(forest.feature_importances_)[::-1]
     out["importances"] = {cols[i]: float(forest.feature_importances_[i]) for i in order}
@@ -103,6 +105,16 @@ def _class_scores(metrics, y, pred, classes) -> dict:
         "classes": [str(c) for c in classes],
         "confusion": metrics.confusion_matrix(y, pred, labels=classes).tolist(),
     }
+
+
+def _case_se(errors, groups) -> float:
+    """Standard error of the mean of ``errors`` with cases as the independent units: the
+    standard deviation of the per-case means over sqrt(cases) (windows of a case are not
+    independent)."""
+    import pandas as pd
+
+    per_case = pd.Series(errors).groupby(groups).mean()
+    return float(per_case.std(ddof=1) / np.sqrt(len(per_case))) if len(per_case) > 1 else np.nan
 
 
 def _reg_scores(metrics, y, pred) -> dict:

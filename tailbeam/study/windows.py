@@ -2,7 +2,8 @@
 
 Two kinds of window, each a row of the table with one column per sensor and feature
 (``<sensor>.<feature>``):
-- ``impact``: ``length`` s starting ``pre`` s before each impact of impacts.parquet; the row's
+- ``impact``: ``length`` s starting ``pre`` s before each impact of impacts.parquet (of a
+  stream dataset: its plate rows only, not the ball-ball rows); the row's
   ``label`` is the class of the ball that struck (coal | gangue). Impacts whose window would
   run past the record are left out (and counted).
 - ``fixed``: consecutive non-overlapping windows of ``length`` s; the row's ``label`` is the
@@ -117,6 +118,8 @@ def feature_table(
     if n < 16:
         raise InputError("--length", f"must span at least 16 samples, {16 / fs:g} s")
     impacts = pd.read_parquet(folder / "impacts.parquet") if window == "impact" else None
+    if impacts is not None and "partner" in impacts.columns:  # a stream's: plate rows only
+        impacts = impacts[impacts["partner"] == "plate"]
     if impacts is not None and first_only:
         impacts = impacts[impacts["index"] == 1]
     cases = case_table(ds)
