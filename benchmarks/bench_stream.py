@@ -13,7 +13,7 @@ Rows:
 - cost against particle count at the same rate (100, 300, 1000, 3000 particles, rigid
   plate): wall time, contacts, and the fitted exponent of time against particles;
 - the reference scene on the modal plate (band 10 kHz, basis cached, two 51.2 kHz sensors:
-  the stream's plate forces drive the modes one way) against the same on the rigid plate;
+  coupled both ways) against the same on the rigid plate;
 - accuracy against converged runs: first-impact peak force of every particle at rtol 1e-10
   (the default) against rtol 1e-12; in-band sensor RMS with the 10 kHz band against a 20 kHz
   band.

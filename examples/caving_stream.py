@@ -6,7 +6,7 @@ Two streams with the same seed, so the same arrivals, sizes, release points and 
 in one every particle is coal, in the other 30 % are sandstone (gangue). They fall onto the
 30-degree SSSS plate of ``examples/caving_stream.toml``; the stream solver finds every contact
 (ball-ball and ball-plate) on the rigid plate and the plate forces drive the modes to
-10 kHz (one-way coupling, docs/streams.md), read by two 51.2 kHz accelerometers.
+10 kHz, coupled both ways (docs/streams.md), read by two 51.2 kHz accelerometers.
 
 Quick mode (default): 200 particles over 1 s (2 s simulated, about a minute with the basis
 cached); ``--full``: the reference scene (1000 particles over 5 s, 6 s simulated).
