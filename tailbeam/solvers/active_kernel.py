@@ -9,6 +9,12 @@ O(1) for far pairs and balls far from the edges), else the 15 Chebyshev values o
 first-crossing search (``cheb_events``). Helpers take arrays one by one and are compiled
 without reference counting (``tailbeam.solvers.jit``); only ``advance`` allocates.
 
+With the optional modal plate (m modes after the balls in the state, ``active_pairs``) the
+plate's deflection under a plate pair at the 15 points and at the force-row nodes comes from
+the modes projected on that pair's phi first (``_project``, ``_ensure_plate``: O(m) per pair
+and step); the far-pair bound adds sum |phi_k| B_k; the error norm is taken per block (balls,
+modes). Without modes every operation and result is the rigid plate's, bit for bit.
+
 Event handling is the reference's (``stream_reference``): a step in which a row crosses is
 discarded and redone to end exactly at the crossing, and the redone step is checked again
 (an earlier root wins). At the end of the redone step the event is applied if its row is
