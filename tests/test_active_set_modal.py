@@ -55,8 +55,8 @@ def test_single_ball_matches_the_coupled_solver(damping):
     # 800 and 1600 steps per contact are Richardson-extrapolated; |x1600 - x800| measures how
     # far the coupled solver still is from its limit. Measured (c = 0 / c = 800, rtol 1e-12):
     # t_end, v_out, peak within 6.6e-10, 8.0e-10, 2.3e-9 / 4.1e-10, 1.8e-10, 2.8e-9 (relative)
-    # of the extrapolation, 40-2000x closer than |x1600 - x800| (3.7e-8 ... 1.3e-6); modal
-    # state q, q' within 1.7e-9, 4.2e-9 / 1.1e-9, 3.7e-9 (norm), 400-500x closer than
+    # of the extrapolation, 40-7000x closer than |x1600 - x800| (3.7e-8 ... 1.3e-6); modal
+    # state q, q' within 1.7e-9, 4.2e-9 / 1.1e-9, 3.7e-9 (norm), 390-540x closer than
     # |x1600 - x800|; max penetration (the coupled solver's maximum over its nodes, not
     # extrapolable) within 1.5e-7 / 2.8e-8 of its 1600-step value.
     ball = Ball("s", SANDSTONE, R, (XY[0], XY[1], R + 1e-4), (0.0, 0.0, -2.0))
@@ -102,7 +102,7 @@ def test_two_balls_share_the_modes_as_in_the_coupled_solver():
     # on a plate already moved by it (its start is 7.6e-8 s earlier than over the rigid plate).
     # Every record of both against the coupled solver (Richardson, as above). Measured: start
     # times within 7e-15 s (the start dead band); end, v_out, peak within 6.3e-10, 4.6e-9,
-    # 2.8e-9 (relative) of the (800, 1600) extrapolation, >= 100x closer than |x1600 - x800|;
+    # 2.8e-9 (relative) of the (800, 1600) extrapolation, 99-800x closer than |x1600 - x800|;
     # the (1600, 3200) extrapolation (not run here) comes within 2.8e-10, 7.2e-10: what is
     # left is the reference's. Max penetration within 4.7e-7 of the 1600-step value.
     balls = [
@@ -207,6 +207,43 @@ def test_energy_is_conserved_without_damping():
     assert kinds.count("contact_end") >= 5
     assert modal_max > 0.5  # the plate really takes part
     assert drift < 1e-9
+
+
+def _modes_from_rows(s, zeta):
+    """q, q' after driving the modes (from rest) with the set's plate force rows, linear in
+    time between rows, by the exact propagator."""
+    rows = s.force_rows()
+    order = np.argsort(rows[:, 0], kind="stable")
+    t, f = rows[order, 0], rows[order, 2]
+    m = BASIS.n_modes
+    q, qd, q1, qd1, coef = np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((8, m))
+    for k in range(len(t) - 1):
+        if t[k + 1] > t[k]:
+            propagator.coefficients(BASIS.omega, zeta, t[k + 1] - t[k], coef)
+            propagator.advance(coef, q, qd, -s.phi[0] * f[k], -s.phi[0] * f[k + 1], q1, qd1)
+            q, qd = q1.copy(), qd1.copy()
+    return q, qd
+
+
+def test_force_rows_drive_the_modes_as_inside_the_set():
+    # The plate force rows (for the sensors) replayed through the exact propagator give the
+    # set's own modal state after the contact, up to their linear interpolation: measured
+    # 1.05e-5 / 7.6e-7 (q, relative norm) with 10 / 40 nodes per step, a ratio of 13.9 =
+    # (41 / 11)^2: second order in the row spacing (c = 800: ramp and clamp kinks included).
+    ball = Ball("s", SANDSTONE, R, (XY[0], XY[1], R + 1e-4), (0.0, 0.0, -2.0))
+    law = ball_plate_law(SANDSTONE, R, PLATE.material, damping=800.0)
+    zeta = np.full(BASIS.n_modes, ZETA)
+    errors = []
+    for nodes in (10, 40):
+        s = _modal_set(ball, law, zeta=ZETA, nodes_per_step=nodes)
+        start = s.advance(0.0, 1e-3)
+        assert s.advance(start.t, 1e-3).kind == "contact_end"
+        q, qd = _modes_from_rows(s, zeta)
+        errors.append([np.linalg.norm(q - s.q) / np.linalg.norm(s.q),
+                       np.linalg.norm(qd - s.qd) / np.linalg.norm(s.qd)])  # fmt: skip
+    errors = np.array(errors)
+    assert np.all(errors[1] < 3e-6)
+    assert np.all(errors[0] / errors[1] > 10.0)  # (41 / 11)^2 = 13.9
 
 
 def test_bad_modal_input_names_the_argument():

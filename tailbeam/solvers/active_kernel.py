@@ -9,6 +9,12 @@ O(1) for far pairs and balls far from the edges), else the 15 Chebyshev values o
 first-crossing search (``cheb_events``). Helpers take arrays one by one and are compiled
 without reference counting (``tailbeam.solvers.jit``); only ``advance`` allocates.
 
+With the optional modal plate (m modes after the balls in the state, ``active_pairs``) the
+plate's deflection under a plate pair at the 15 points and at the force-row nodes comes from
+the modes projected on that pair's phi first (``_project``, ``_ensure_plate``: O(m) per pair
+and step); the far-pair bound adds sum |phi_k| B_k; the error norm is taken per block (balls,
+modes). Without modes every operation and result is the rigid plate's, bit for bit.
+
 Event handling is the reference's (``stream_reference``): a step in which a row crosses is
 discarded and redone to end exactly at the crossing, and the redone step is checked again
 (an earlier root wins). At the end of the redone step the event is applied if its row is
@@ -34,7 +40,8 @@ from tailbeam.solvers.active_pairs import (
     first_contact_step,
     pair_force,
     pair_state,
-    region_force,
+    plate_force,
+    plate_row_value,
     rhs,
     rhs_arrays,
     row_band,
@@ -197,9 +204,11 @@ def _prepare(dense):
     """Start of a step's event work: no ball evaluated at the Chebyshev points yet, and the
     bound B[q] = sum_i |coef[i, q]| >= |y_q(s) - y_q(0)| on the whole step (every factor of
     the dense output's nested form lies in [0, 1])."""
-    Y15, have, coef, y, B = dense
+    Y15, have, coef, y, B, W15, have_w, proj = dense
     for b in range(have.shape[0]):
         have[b] = False
+    for p in range(have_w.shape[0]):
+        have_w[p] = False
     for q in range(y.shape[0]):
         acc = 0.0
         for i in range(7):
@@ -209,20 +218,11 @@ def _prepare(dense):
 
 @helper_njit
 def _ensure(Y15, have, coef, y, pts, b):
-    """Ball b's 6 state components at the 15 Chebyshev points of the step (once per step);
-    b < 0 (the plate): the modal block, if any (flag have[n])."""
-    n = have.shape[0] - 1
-    if b < 0:
-        if have[n] or y.shape[0] == 6 * n:
-            return
-        have[n] = True
-        for q in range(pts.shape[0]):
-            for c in range(6 * n, y.shape[0]):
-                Y15[q, c] = _dense1(coef, y, pts[q], c)
-        return
-    if have[b]:
+    """Ball b's 6 state components at the 15 Chebyshev points of the step (once per step)."""
+    if b < 0 or have[b]:
         return
     have[b] = True
+    n = have.shape[0]
     for q in range(pts.shape[0]):
         for k in range(3):
             Y15[q, 3 * b + k] = _dense1(coef, y, pts[q], 3 * b + k)
@@ -251,6 +251,21 @@ def _dense_projected(c8, s):
         a += c8[i]
         a *= s if (6 - i) % 2 == 0 else 1.0 - s
     return c8[7] + a
+
+
+@helper_njit
+def _ensure_plate(W15, have_w, coef, y, pts, phi, p, n, proj):
+    """The plate's deflection and velocity under plate pair p at the 15 Chebyshev points of
+    the step (once per step): the modes projected on phi[p] first (O(modes), not 15 x modes)."""
+    if have_w[p]:
+        return
+    have_w[p] = True
+    nm = phi.shape[1]
+    _project(coef, y, phi, p, 6 * n, proj[0])
+    _project(coef, y, phi, p, 6 * n + nm, proj[1])
+    for q in range(pts.shape[0]):
+        W15[q, p, 0] = _dense_projected(proj[0], pts[q])
+        W15[q, p, 1] = _dense_projected(proj[1], pts[q])
 
 
 @helper_njit
@@ -292,7 +307,7 @@ def _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp, phi):
 @helper_njit
 def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, pj, law,
                   rsum, touching, ramp, clamped, vals, wc, wv, wc2, wd, stack, tmp, model,
-                  pstate):  # fmt: skip
+                  pstate, W15, have_w, proj):  # fmt: skip
     """First crossing (fraction of the step, inf if none) of row (kind, idx): the bound B,
     else the 15-point certificate, else the search (``cheb_events``)."""
     phi = model[12]
@@ -302,11 +317,19 @@ def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, 
         _ensure(Y15, have, coef, y, pts, idx // 4)
     else:
         _ensure(Y15, have, coef, y, pts, pi[idx])
-        _ensure(Y15, have, coef, y, pts, pj[idx])  # (the plate: the modal block)
-    for q in range(pts.shape[0]):
-        vals[q] = row_value_arrays(
-            kind, idx, Y15[q], n, half, pi, pj, law, rsum, touching, ramp, clamped, phi
-        )
+        _ensure(Y15, have, coef, y, pts, pj[idx])
+    if kind != R_EDGE and pj[idx] < 0:
+        _ensure_plate(W15, have_w, coef, y, pts, phi, idx, n, proj)
+        i = pi[idx]
+        for q in range(pts.shape[0]):
+            vals[q] = plate_row_value(kind, idx, Y15[q, 3 * i + 2], Y15[q, 3 * n + 3 * i + 2],
+                                      W15[q, idx, 0], W15[q, idx, 1], law, rsum, touching, ramp,
+                                      clamped)  # fmt: skip
+    else:
+        for q in range(pts.shape[0]):
+            vals[q] = row_value_arrays(
+                kind, idx, Y15[q], n, half, pi, pj, law, rsum, touching, ramp, clamped, phi
+            )
     if kind == R_CLAMP:
         return _sampled_crossing(kind, idx, vals, fr, y, coef, pts, model, pstate, tmp)
     cheb_coefficients(vals, vinv, wc)
@@ -321,7 +344,7 @@ def _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
     are unpacked once here: the helpers take arrays, see ``rhs_arrays``.)"""
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
-    Y15, have, coef, y, B = dense
+    Y15, have, coef, y, B, W15, have_w, proj = dense
     vals, wc, wv, wc2, wd, stack, tmp = ws
     n = mass.shape[0]
     best_s, best_k, best_i = math.inf, -1, -1
@@ -336,7 +359,7 @@ def _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
             fr = _is_fresh(kind, p, fresh, nfresh)
             s = _row_crossing(kind, p, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, pj,
                               law, rsum, touching, ramp, clamped, vals, wc, wv, wc2, wd, stack,
-                              tmp, model, pstate)  # fmt: skip
+                              tmp, model, pstate, W15, have_w, proj)  # fmt: skip
             if s < best_s:
                 best_s, best_k, best_i = s, kind, p
     kind_edge = np.int64(R_EDGE)  # (typed like the pair kinds: one compiled signature)
@@ -347,7 +370,8 @@ def _detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
             fr = _is_fresh(kind_edge, 4 * b + e, fresh, nfresh)  # (False: LEAVE returns)
             s = _row_crossing(kind_edge, 4 * b + e, fr, Y15, have, coef, y, B, pts, vinv, n,
                               half, pi, pj, law, rsum, touching, ramp, clamped, vals, wc, wv,
-                              wc2, wd, stack, tmp, model, pstate)  # fmt: skip
+                              wc2, wd, stack, tmp, model, pstate, W15, have_w,
+                              proj)  # fmt: skip
             if s < best_s:
                 best_s, best_k, best_i = s, R_EDGE, 4 * b + e
     return best_s, best_k, best_i
@@ -363,26 +387,21 @@ def _write_row(rows, iout, t, p, f):
 
 
 @helper_njit
-def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws, proj):
+def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
     """Peak force / max penetration of the touching pairs on the accepted step (maximum of
     their Chebyshev interpolant, refined where the nodes come within 1 % of the record), and
     the plate force rows at ``nodes`` interior points and the step end."""
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     touching, ramp, clamped, peak, t_peak, pen = pstate
     vals, wc, wv, wc2, wd, stack, tmp = ws
-    Y15, have, coef, y, B = dense
-    n = mass.shape[0]
+    Y15, have, coef, y, B, W15, have_w, proj = dense
     for p in range(pi.shape[0]):
         if not touching[p]:
             continue
-        _ensure(Y15, have, coef, y, pts, pi[p])
-        _ensure(Y15, have, coef, y, pts, pj[p])
+        _pair_values(p, dense, pts, model, pstate, vals, wv)
         fmax = -math.inf
         for q in range(pts.shape[0]):
-            f, delta, _, _, _ = pair_force(Y15[q], n, p, pi, pj, law, rsum, ramp, clamped, phi)
-            vals[q] = f
-            wv[q] = delta
-            fmax = max(fmax, f)
+            fmax = max(fmax, vals[q])
         if fmax >= 0.99 * peak[p]:
             s, fm = interpolant_max(vals, vinv, wc, wc2)
             if fm > peak[p]:
@@ -400,6 +419,28 @@ def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws, 
 
 
 @helper_njit
+def _pair_values(p, dense, pts, model, pstate, forces, deltas):
+    """Force (N) and penetration (m) of touching pair p at the 15 Chebyshev points."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    ramp, clamped = pstate[1], pstate[2]
+    Y15, have, coef, y, B, W15, have_w, proj = dense
+    n = mass.shape[0]
+    i, j = pi[p], pj[p]
+    _ensure(Y15, have, coef, y, pts, i)
+    if j >= 0:
+        _ensure(Y15, have, coef, y, pts, j)
+        for q in range(pts.shape[0]):
+            f, delta, _, _, _ = pair_force(Y15[q], n, p, pi, pj, law, rsum, ramp, clamped, phi)
+            forces[q], deltas[q] = f, delta
+        return
+    _ensure_plate(W15, have_w, coef, y, pts, phi, p, n, proj)
+    for q in range(pts.shape[0]):
+        forces[q], deltas[q] = plate_force(p, Y15[q, 3 * i + 2], Y15[q, 3 * n + 3 * i + 2],
+                                           W15[q, p, 0], W15[q, p, 1], law, rsum, ramp,
+                                           clamped)  # fmt: skip
+
+
+@helper_njit
 def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj):
     """Force rows of plate pair p at ``nodes`` interior points of the step and its end (the
     plate deflection under the ball from its projected dense output, ``_project``)."""
@@ -411,12 +452,12 @@ def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj):
     wq, wv = proj[0], proj[1]
     _project(coef, y, phi, p, 6 * n, wq)
     _project(coef, y, phi, p, 6 * n + nm, wv)
-    k_, e_, c_, d_ = law[p, 0], law[p, 1], law[p, 2], law[p, 3]
     for k in range(1, nodes + 1):
         s = k / (nodes + 1.0)
-        z = _dense1(coef, y, s, 3 * i + 2) - _dense_projected(wq, s)
-        vz = _dense1(coef, y, s, 3 * n + 3 * i + 2) - _dense_projected(wv, s)
-        f = region_force(rsum[p] - z, -vz, k_, e_, c_, d_, ramp[p], clamped[p])
+        z = _dense1(coef, y, s, 3 * i + 2)
+        vz = _dense1(coef, y, s, 3 * n + 3 * i + 2)
+        f = plate_force(p, z, vz, _dense_projected(wq, s), _dense_projected(wv, s), law, rsum,
+                        ramp, clamped)[0]  # fmt: skip
         _write_row(rows, iout, t + s * h, p, f)
     f = pair_force(ynew, n, p, pi, pj, law, rsum, ramp, clamped, phi)[0]
     _write_row(rows, iout, t + h, p, f)
@@ -534,11 +575,12 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
     coef = np.zeros((7, nst))
     npts = pts.shape[0]
     nb = model[0].shape[0]
-    dense = (np.zeros((npts, nst)), np.zeros(nb + 1, dtype=np.bool_), coef, np.zeros(nst),
-             np.zeros(nst))  # fmt: skip
+    npairs = model[4].shape[0]
+    dense = (np.zeros((npts, nst)), np.zeros(nb, dtype=np.bool_), coef, np.zeros(nst),
+             np.zeros(nst), np.zeros((npts, npairs, 2)), np.zeros(npairs, dtype=np.bool_),
+             np.zeros((2, 8)))  # fmt: skip
     ws = (np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts),
           np.zeros((256, 3)), np.zeros(nst))  # fmt: skip
-    proj = np.zeros((2, 8))
     count = np.zeros(nb, dtype=np.int64)
     plate_pair = np.zeros(nb, dtype=np.int64)
     fresh = np.zeros((MAX_FRESH, 2), dtype=np.int64)
@@ -604,7 +646,7 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
             factor = min(1.0, factor)
         rejected = False
         if k < 0:
-            _accept(t, hh, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws, proj)
+            _accept(t, hh, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws)
             t = t_bound if last else t + hh
             y[:] = ynew
             f0[:] = K[12]

@@ -135,6 +135,17 @@ def pair_force(y, n, p, pi, pj, law, rsum, ramp, clamped, phi):
 
 
 @helper_njit
+def plate_force(p, z, vz, w, wd, law, rsum, ramp, clamped):
+    """(F N, delta m) of plate pair p in its region from the ball's height z (m) and speed vz
+    (m/s) and the plate's deflection w (m) and velocity wd (m/s) under it."""
+    delta = rsum[p] - (z - w)
+    f = region_force(
+        delta, -(vz - wd), law[p, L_K], law[p, L_E], law[p, L_C], law[p, L_D], ramp[p], clamped[p]
+    )
+    return f, delta
+
+
+@helper_njit
 def rhs_arrays(y, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, omega, zeta,
                phi, fdead, out):  # fmt: skip
     """dy/dt of the active set: gravity on every present ball plus the touching pairs, and the
@@ -214,20 +225,40 @@ def row_value_arrays(kind, idx, y, n, half, pi, pj, law, rsum, touching, ramp, c
         f = c + h if e % 2 == 0 else h - c
         return f + EDGE_BAND
     i, j, rs = pi[idx], pj[idx], rsum[idx]
+    if j < 0:
+        w, wd = plate_deflection(y, n, phi, idx)
+        return plate_row_value(kind, idx, y[3 * i + 2], y[3 * n + 3 * i + 2], w, wd, law, rsum,
+                               touching, ramp, clamped)  # fmt: skip
     if kind == R_CLAMP:
         delta, rate, _, _, _ = pair_state(y, n, i, j, rs, phi, idx)
-        ind = clamp_indicator(
-            delta, rate, law[idx, L_K], law[idx, L_E], law[idx, L_C], law[idx, L_D], ramp[idx]
-        )
-        return (-ind if clamped[idx] else ind) + CLAMP_BAND
-    if j < 0:
-        gap = y[3 * i + 2] - plate_deflection(y, n, phi, idx)[0]
-        d2 = gap * gap
-    else:
-        dx = y[3 * i] - y[3 * j]
-        dy = y[3 * i + 1] - y[3 * j + 1]
-        dz = y[3 * i + 2] - y[3 * j + 2]
-        d2 = dx * dx + dy * dy + dz * dz
+        return _clamp_row(idx, delta, rate, law, ramp, clamped)
+    dx = y[3 * i] - y[3 * j]
+    dy = y[3 * i + 1] - y[3 * j + 1]
+    dz = y[3 * i + 2] - y[3 * j + 2]
+    return _distance_row(kind, idx, dx * dx + dy * dy + dz * dz, rs, law, touching, ramp)
+
+
+@helper_njit
+def plate_row_value(kind, p, z, vz, w, wd, law, rsum, touching, ramp, clamped):
+    """``row_value_arrays`` of plate pair p (not an edge row) from the ball's z, vz and the
+    plate's w, wd under it."""
+    if kind == R_CLAMP:
+        return _clamp_row(p, rsum[p] - (z - w), -(vz - wd), law, ramp, clamped)
+    gap = z - w
+    return _distance_row(kind, p, gap * gap, rsum[p], law, touching, ramp)
+
+
+@helper_njit
+def _clamp_row(idx, delta, rate, law, ramp, clamped):
+    ind = clamp_indicator(
+        delta, rate, law[idx, L_K], law[idx, L_E], law[idx, L_C], law[idx, L_D], ramp[idx]
+    )
+    return (-ind if clamped[idx] else ind) + CLAMP_BAND
+
+
+@helper_njit
+def _distance_row(kind, idx, d2, rs, law, touching, ramp):
+    """Contact / full-damping row from the squared centre distance d2 (the gap^2 on the plate)."""
     band = 1e-12 * rs * rs
     if kind == R_CONTACT:
         f = d2 - rs * rs
