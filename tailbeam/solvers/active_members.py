@@ -17,6 +17,7 @@ from tailbeam.physics.incline import EDGES
 from tailbeam.solvers.active_pairs import first_contact_step, settle_excess
 from tailbeam.solvers.active_set import ActiveSet, law_table
 
+SHAPE_REUSE = 2.5e-4  # m: mode shapes computed within this distance are reused (modal plate)
 _KIND = {"contact_start": "start", "contact_end": "end", "leave": "leave", "settle": "settle"}
 
 
@@ -38,6 +39,7 @@ class ActiveMembers:
         self._laws = {}
         self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
         self.totals = {"kernel_steps": 0, "kernel_attempts": 0, "kernel_nfev": 0, "rebuilds": 0}
+        self._shape_cache = {}  # ball -> (xy, mode shapes there): modal plate
         self._x = {}  # state of members added since the last build
         self._v = {}
 
@@ -116,7 +118,7 @@ class ActiveMembers:
             return {}
         plate.propagate(self.now)
         plate.set_dead_loads(*self.dead_loads())
-        shapes = plate.shapes(np.array([self._x[i][:2] for i in members]).reshape(-1, 2))
+        shapes = self._shapes(members, [self._x[i][:2] for i in members])
         phi = np.zeros((len(self.keys), plate.n_modes))
         for q in range(len(members)):
             phi[q] = shapes[q]  # the plate pairs come first, in member order
@@ -136,10 +138,31 @@ class ActiveMembers:
         if self.plate is None or not self.members:
             return
         s = self._ready()
-        for q, i in enumerate(self.members):
-            p = self.index[(i, -1)]
-            if not s.touching[p]:
-                s.set_phi(p, self.plate.shapes(s.x[q, :2])[0])
+        free = [(q, i) for q, i in enumerate(self.members) if not s.touching[self.index[(i, -1)]]]
+        if not free:
+            return
+        shapes = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
+        for (_, i), shape in zip(free, shapes, strict=True):
+            s.set_phi(self.index[(i, -1)], shape)
+
+    def _shapes(self, balls, xy) -> np.ndarray:
+        """Mode shapes under ``balls`` at ``xy``: each ball's cached row unless it moved more
+        than SHAPE_REUSE since it was computed (one batched evaluation for the rest)."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        out = np.empty((len(balls), self.plate.n_modes))
+        todo = []
+        for k, i in enumerate(balls):
+            cached = self._shape_cache.get(i)
+            if cached is not None and np.hypot(*(cached[0] - xy[k])) <= SHAPE_REUSE:
+                out[k] = cached[1]
+            else:
+                todo.append(k)
+        if todo:
+            fresh = self.plate.shapes(xy[todo])
+            for k, row in zip(todo, fresh, strict=True):
+                out[k] = row
+                self._shape_cache[balls[k]] = (xy[k].copy(), row)
+        return out
 
     def _count(self):
         if self.set is not None:
