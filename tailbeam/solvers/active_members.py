@@ -67,6 +67,8 @@ class ActiveMembers:
         for q, i in enumerate(self.members):
             self._x[i], self._v[i] = self.set.x[q].copy(), self.set.v[q].copy()
         self._pairs = {k: self._pair_state(p) for k, p in self.index.items()}
+        if self.plate is not None:  # each plate pair keeps its mode shapes (its contact point)
+            self._phi = {k: self.set.phi[p].copy() for k, p in self.index.items() if k[1] < 0}
 
     def _pair_state(self, p):
         s = self.set
@@ -118,10 +120,12 @@ class ActiveMembers:
             return {}
         plate.propagate(self.now)
         plate.set_dead_loads(*self.dead_loads())
-        shapes = self._shapes(members, [self._x[i][:2] for i in members])
+        kept = getattr(self, "_phi", {})
+        new = [i for i in members if (i, -1) not in kept]
+        shapes = dict(zip(new, self._shapes(new, [self._x[i][:2] for i in new]), strict=True))
         phi = np.zeros((len(self.keys), plate.n_modes))
-        for q in range(len(members)):
-            phi[q] = shapes[q]  # the plate pairs come first, in member order
+        for q, i in enumerate(members):  # the plate pairs come first, in member order
+            phi[q] = kept[(i, -1)] if (i, -1) in kept else shapes[i]
         for q, i in enumerate(members):
             if i in self.quiet:
                 self._x[i][2] = self.balls.radius[i] - self.balls.static_pen[i] + phi[q] @ plate.q
@@ -143,7 +147,12 @@ class ActiveMembers:
             return
         shapes = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
         for (_, i), shape in zip(free, shapes, strict=True):
-            s.set_phi(self.index[(i, -1)], shape)
+            p = self.index[(i, -1)]
+            # only where the change of the plate under the ball cannot close its gap (a
+            # ball just off the plate keeps its shapes: no start or end out of nothing)
+            gap = -s.penetration(p)[0]
+            if gap > abs((shape - s.phi[p]) @ s.q) + 1e-9:
+                s.set_phi(p, shape)
 
     def _shapes(self, balls, xy) -> np.ndarray:
         """Mode shapes under ``balls`` at ``xy``: each ball's cached row unless it moved more

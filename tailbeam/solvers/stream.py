@@ -574,7 +574,9 @@ class _Stream:
             self.set_end = t
             return
         h = SET_HORIZON
-        self.set_end = min([t + h] + [self.limit[i] for i in core if i in self.limit])
+        # (a limit already reached waits for the ball's other contacts to end)
+        limits = [self.limit[i] for i in core if i in self.limit and self.limit[i] > t]
+        self.set_end = min([t + h] + limits)
         if self.plate is not None:  # mode shapes where the landing balls will touch
             self.act.refresh_shapes()
             for i in self.landing:
