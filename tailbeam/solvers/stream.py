@@ -164,6 +164,7 @@ class _Stream:
             self.balls, options, rtol, self._settle_energy, plate, self._resting_outside
         )
         self.landing = set()  # modal plate: balls within the deflection bound, touching nothing
+        self.hold = {}  # ball -> time of a contact end: core until time moves on
         self.w_margin = 0.0  # modal plate: plate touches are predicted this far above it
         self.heap, self.seq, self.t, self.loops = [], 0, 0.0, 0
         self.epoch_end, self.set_end = 0.0, 0.0
@@ -409,6 +410,9 @@ class _Stream:
 
     def _on_end(self, key):
         i, j = key
+        for k in key:  # the set keeps its members until time moves on (no rebuild at the end
+            if k >= 0:  # instant: a rebuilt set could find the same contact starting again)
+                self.hold[k] = self.t
         if key not in self.open:  # a pair the set found overlapping (counted in late_starts)
             return
         if j >= 0:
@@ -452,7 +456,7 @@ class _Stream:
                 self._on_settle(i)
 
     def _is_core(self, i: int) -> bool:
-        if i in self.landing:
+        if i in self.landing or self.hold.get(i) == self.t:
             return True
         return any(key in self.open for key in self.act.touching_pairs(i))
 
@@ -563,6 +567,7 @@ class _Stream:
         """Core = members with a contact in progress; members = core + every closed-form
         ball that could reach a core ball within SET_HORIZON (certified bounds)."""
         b, t = self.balls, self.t
+        self.hold = {i: th for i, th in self.hold.items() if th == t}
         self._persistent_to_rest()
         for i in [i for i in self.core if not self._is_core(i)]:
             self._release_from_core(i)
