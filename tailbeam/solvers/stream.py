@@ -35,7 +35,7 @@ from tailbeam.contact_law import HERTZ_EXPONENT
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.hertz import hertz_contact_duration
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.progress import quiet, task
+from tailbeam.progress import note, quiet, task
 from tailbeam.solvers.broadphase import candidate_pairs
 from tailbeam.solvers.records import PLATE, ContactRecord, EventKind, LeaveEvent
 from tailbeam.solvers.stream_state import ACTIVE, FLY, GONE, PENDING, SLIDE, Balls, LawOptions
@@ -44,6 +44,7 @@ DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
 DEFAULT_MAX_STEPS = 50_000_000  # kernel steps + events: the work bound
 MAX_PARTICLES = 200_000  # per scene: memory ~40 kB per particle (records, force histories)
+GRAZING_RETRIES = 2  # runs again at rtol / 10, / 100 after a grazing contact stalls it
 STUCK_LIMIT = 5_000  # loop rounds without time moving before the run is stopped
 SET_HORIZON = 1e-3  # s: the active set looks this far ahead for balls that could reach it
 RELEASE_RETRY = 1e-3  # s: a particle that would overlap a ball at its release waits this long
@@ -128,7 +129,23 @@ def solve_stream(
     if rest_speed < 0:
         raise InputError("rest_speed", f"must be >= 0, got {rest_speed!r}")
     options = LawOptions(exponent, damping, penetration, clamp)
-    sim = _Stream(particles, incline, duration, options, rtol, rest_speed, max_work, plate)
+    for attempt in range(GRAZING_RETRIES + 1):
+        if plate is not None:
+            plate.reset()
+        sim = _Stream(particles, incline, duration, options, rtol, rest_speed, max_work, plate)
+        try:
+            run = _run(sim, duration, progress)
+        except _Stuck as err:
+            if attempt == GRAZING_RETRIES:
+                raise WorkLimitError(str(err)) from None
+            rtol *= 0.1
+            note(f"{err}; running again with rtol {rtol:g}")
+            continue
+        run.stats["rtol"] = rtol
+        return run
+
+
+def _run(sim, duration, progress) -> "StreamRun":
     label = f"simulating {duration:g} s, {len(sim.balls.names)} particles"
     with contextlib.ExitStack() as stack:
         if callable(progress):
@@ -138,6 +155,10 @@ def solve_stream(
                 stack.enter_context(quiet())
             bar = stack.enter_context(task(label, total=1e3 * duration, unit="ms simulated"))
         return sim.run(bar)
+
+
+class _Stuck(WorkLimitError):
+    """Contacts start and end again at one instant: no progress (a grazing contact)."""
 
 
 class _CallbackBar:
@@ -222,7 +243,7 @@ class _Stream:
             stuck = stuck + 1 if self.t == t_last else 0
             t_last = self.t
             if stuck > STUCK_LIMIT:
-                raise WorkLimitError(self._stuck_message())
+                raise _Stuck(self._stuck_message())
             t_next = self.heap[0][0] if self.heap else math.inf
             target = min(t_next, self.duration)
             if self.act.members and self._advance_set(target):
@@ -243,7 +264,7 @@ class _Stream:
         return (
             f"rtol: the stream solver makes no progress at t = {self.t:.9g} s: contacts of "
             f"{', '.join(names)} start and end again at one instant (a grazing contact the "
-            "event restart cannot resolve, a known limitation); change rtol (or the seed)"
+            "event restart cannot resolve, a known limitation); a tighter rtol resolves it"
         )
 
     def _check_work(self):

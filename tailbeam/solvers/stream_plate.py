@@ -40,6 +40,11 @@ class StreamPlate:
         grid = np.array([(x, y) for x in xs for y in ys])
         self.phi_max = GRID_SAFETY * np.max(np.abs(basis.deflection(grid)), axis=0)
 
+    def reset(self) -> None:
+        """The plate at rest at t = 0 (before a run)."""
+        self.q[:], self.qd[:], self.f_dead[:] = 0.0, 0.0, 0.0
+        self.t = 0.0
+
     @property
     def n_modes(self) -> int:
         return self.omega.shape[0]
