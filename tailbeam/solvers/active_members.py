@@ -14,7 +14,7 @@ import numpy as np
 
 from tailbeam.contact_law import ball_ball_law
 from tailbeam.physics.incline import EDGES
-from tailbeam.solvers.active_pairs import first_contact_step, settle_excess
+from tailbeam.solvers.active_pairs import elastic_energy, first_contact_step, settle_excess
 from tailbeam.solvers.active_set import ActiveSet, law_table
 
 SHAPE_REUSE = 2.5e-4  # m: mode shapes computed within this distance are reused (modal plate)
@@ -256,7 +256,7 @@ class ActiveMembers:
         for p in np.flatnonzero(s.touching):
             delta, _ = s.penetration(p)
             k, e = s.law[p, 0], s.law[p, 1]
-            elastic += k * max(delta, 0.0) ** (e + 1.0) / (e + 1.0)
+            elastic += elastic_energy(delta, k, e)
         return kinetic + elastic
 
     def elastic_energy_of(self, i: int) -> float:
@@ -269,7 +269,7 @@ class ActiveMembers:
             delta, _ = s.penetration(p)
             k, e = s.law[p, 0], s.law[p, 1]
             share = 1.0 if key[1] < 0 else 0.5
-            total += share * k * max(delta, 0.0) ** (e + 1.0) / (e + 1.0)
+            total += share * elastic_energy(delta, k, e)
         return total
 
     def touching_pairs(self, i: int) -> list:

@@ -31,24 +31,24 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tailbeam.contact_law import HERTZ_EXPONENT
+from tailbeam.contact_law import HERTZ_EXPONENT, elastic_energy
 from tailbeam.errors import InputError, WorkLimitError, require_positive
-from tailbeam.hertz import hertz_contact_duration
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import note, quiet, task
 from tailbeam.solvers.broadphase import candidate_pairs
-from tailbeam.solvers.records import PLATE, ContactRecord, EventKind, LeaveEvent
-from tailbeam.solvers.stream_state import ACTIVE, FLY, GONE, PENDING, SLIDE, Balls, LawOptions
+from tailbeam.solvers.records import PLATE, EventKind, LeaveEvent
+from tailbeam.solvers.stream_records import StreamRecords
+from tailbeam.solvers.stream_state import ACTIVE, FLY, GONE, SLIDE, Balls, LawOptions
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
 DEFAULT_MAX_STEPS = 50_000_000  # kernel steps + events: the work bound
 MAX_PARTICLES = 200_000  # per scene: memory ~40 kB per particle (records, force histories)
 GRAZING_RETRIES = 2  # runs again at rtol / 10, / 100 after a grazing contact stalls it
+WORK_CHECK_EVERY = 16  # loop rounds between two checks of the work bound
 STUCK_LIMIT = 5_000  # loop rounds without time moving before the run is stopped
 SET_HORIZON = 1e-3  # s: the active set looks this far ahead for balls that could reach it
 RELEASE_RETRY = 1e-3  # s: a particle that would overlap a ball at its release waits this long
-REST_CONTACT_FACTOR = 50.0  # a plate contact longer than this many Hertz durations is at rest
 SHAPE_TRAVEL = 1e-3  # m: modal plate: mode shapes refreshed after this much lateral travel
 # heap event kinds (the order breaks ties at equal times: releases first)
 _RELEASE, _EPOCH, _PLATE, _PAIR, _EDGE = range(5)
@@ -172,7 +172,7 @@ class _CallbackBar:
         self.report(self.ms / 1e3)
 
 
-class _Stream:
+class _Stream(StreamRecords):
     """The event loop; see the module docstring."""
 
     def __init__(self, particles, incline, duration, options, rtol, rest_speed, max_events, plate):
@@ -189,7 +189,7 @@ class _Stream:
         self.hold = {}  # ball -> time of a contact end: core until time moves on
         self.grazing = {}  # ball -> (time of its last plate contact end, how many then)
         self.w_margin = 0.0  # modal plate: plate touches are predicted this far above it
-        self.heap, self.seq, self.t, self.loops = [], 0, 0.0, 0
+        self.heap, self.seq, self.t, self.rounds = [], 0, 0.0, 0
         self.epoch_end, self.set_end = 0.0, 0.0
         self.core = set()
         self.contacts, self.leaves, self.events = [], [], []
@@ -268,6 +268,9 @@ class _Stream:
         )
 
     def _check_work(self):
+        self.rounds += 1
+        if self.rounds % WORK_CHECK_EVERY:
+            return
         n = self.stats["heap_events"] + self.stats["set_events"] + self.act.steps()
         if n > self.max_events:
             raise WorkLimitError(
@@ -343,10 +346,8 @@ class _Stream:
             return
         b.set_motion(i, FLY, self.t, b.x0[i].copy(), b.v0[i].copy())
         x, v = b.state(i, self.t)
-        law, pen = b.plate_laws[i], max(b.radius[i] - x[2], 0.0)  # released on the plate
-        self.stats["energy_released"] += self._ball_energy(i, x, v) + float(
-            law.stiffness * pen ** (law.exponent + 1.0) / (law.exponent + 1.0)
-        )
+        on_plate = float(elastic_energy(b.radius[i] - x[2], b.plate_laws[i]))  # released there
+        self.stats["energy_released"] += self._ball_energy(i, x, v) + on_plate
         self.events.append((self.t, EventKind.RELEASE, b.names[i], ""))
         self._predict(i)
         if self.act.members:
@@ -648,103 +649,6 @@ class _Stream:
             self._absorb(int(i))
         for i in cand[~near & b.in_set[cand]]:
             self._exit(int(i))
-
-    # --- records and loads ----------------------------------------------------------------------
-    def _normal(self, key):
-        """Contact normal (from partner to ball i), penetration (m), the balls' states."""
-        i, j = key
-        xi, vi = self.act.state(i)
-        if j < 0:
-            return np.array([0.0, 0.0, 1.0]), self.balls.radius[i] - xi[2], xi, vi, None
-        xj, vj = self.act.state(j)
-        d = xi - xj
-        dist = math.sqrt(d @ d)
-        return d / dist, self.balls.radius[i] + self.balls.radius[j] - dist, xi, vi, vj
-
-    def _open(self, key):
-        b, t = self.balls, self.t
-        i, j = key
-        n, pen, xi, vi, vj = self._normal(key)
-        point = xi - n * (b.radius[i] - 0.5 * max(pen, 0.0))
-        w = vi - (vj if vj is not None else 0.0)
-        rate = float(-(w @ n))
-        partner = PLATE if j < 0 else b.names[j]
-        recs = [ContactRecord(b.names[i], partner, t, point[0], point[1], float(-(vi @ n)), rate)]
-        if j >= 0:
-            recs.append(
-                ContactRecord(b.names[j], b.names[i], t, point[0], point[1], float(vj @ n), rate)
-            )
-        self.act.reset_accumulators(key)
-        self.open[key] = recs
-        if j < 0:
-            self.limit[i] = t + REST_CONTACT_FACTOR * self._hertz_duration(i, recs[0].v_in)
-        self.contacts.extend(recs)
-        self.events.append((t, EventKind.CONTACT_START, b.names[i], partner))
-
-    def _hertz_duration(self, i: int, speed: float) -> float:
-        """Hertz contact duration (s) of ball i on the plate at ``speed`` (>= rest_speed)."""
-        law = self.balls.plate_laws[i]
-        speed = max(speed, self.rest_speed, 1e-3)
-        return hertz_contact_duration(self.balls.mass[i], speed, law.stiffness, law.exponent)
-
-    def _close(self, key, end: str):
-        if key[1] < 0:
-            self.limit.pop(key[0], None)
-        n, _pen, _xi, vi, vj = self._normal(key)
-        recs = self.open.pop(key)
-        w = vi - (vj if vj is not None else 0.0)
-        outs = [float(vi @ n)] + ([float(-(vj @ n))] if vj is not None else [])
-        peak, t_peak, pen = self.act.accumulators(key)
-        for rec, v_out in zip(recs, outs, strict=True):
-            rec.t_end, rec.v_out, rec.approach_out, rec.end = self.t, v_out, float(w @ n), end
-            rec.peak_force, rec.t_peak, rec.max_penetration = peak, t_peak, pen
-        self.events.append((self.t, EventKind.CONTACT_END, recs[0].ball, recs[0].partner))
-
-    def _flush_nodes(self, i: int):
-        """Hand the plate force history of ball i recorded so far to the loads."""
-        piece = self.act.take_plate_forces(i)
-        if piece is not None:
-            self.loads.append(piece)
-
-    def _dead_load(self, i: int, t_to: float, step: float = 2e-3):
-        """Ball i slid from slide_since to t_to: its weight as constant loads on pieces of
-        at most ``step`` m of travel (each at its middle point)."""
-        b = self.balls
-        t_from = b.slide_since[i]
-        b.slide_since[i] = math.nan
-        if not t_to > t_from:
-            return
-        x0, v0 = b.state(i, t_from)
-        x1, _ = b.state(i, t_to)
-        k = max(1, math.ceil(math.dist(x0[:2], x1[:2]) / step))
-        edges = np.linspace(t_from, t_to, k + 1)
-        mid, _ = b.states(np.full(k, i), 0.5 * (edges[:-1] + edges[1:]))
-        weight = b.mass[i] * -b.g[2]
-        for q in range(k):
-            self.dead_loads.append((mid[q, 0], mid[q, 1], edges[q], edges[q + 1], weight))
-
-    def _ball_energy(self, i: int, x, v) -> float:
-        """Kinetic plus gravitational energy of ball i (J; potential 0 at the origin)."""
-        b = self.balls
-        return float(0.5 * b.mass[i] * (v @ v) - b.mass[i] * (b.g @ x))
-
-    def _elastic(self, i: int) -> float:
-        """Elastic energy (J) of the contacts of ball i: its plate contact (quiet or not) and
-        half of each ball-ball contact (the other half is its partner's)."""
-        if i not in self.act.members:
-            law, pen = self.balls.plate_laws[i], self.balls.static_pen[i]
-            rests = self.balls.status[i] == SLIDE
-            return law.stiffness * pen ** (law.exponent + 1) / (law.exponent + 1) if rests else 0.0
-        return self.act.elastic_energy_of(i)
-
-    def _final_energy(self) -> float:
-        b = self.balls
-        total = 0.0
-        for i in np.flatnonzero((b.status != GONE) & (b.status != PENDING)):
-            i = int(i)
-            x, v = self.act.state(i) if b.in_set[i] else b.state(i, self.t)
-            total += self._ball_energy(i, x, v) + self._elastic(i)
-        return total
 
     def _finish(self, wall: float) -> StreamRun:
         b = self.balls
