@@ -52,7 +52,7 @@ def dataset(tmp_path_factory):
     store = DatasetStore(out)
     from tailbeam.scene_file import loads_scene
 
-    store.record([(c, run_case(c.toml, spec.coal), loads_scene(c.toml)) for c in expand(spec)])
+    store.record([(c, run_case(c.toml), loads_scene(c.toml)) for c in expand(spec)])
     return out
 
 
