@@ -96,7 +96,7 @@ class StreamResult(Result):
             yield _twelve(rec, count[rec.ball], g_n, starts, leave), rec
 
     def _event_rows(self):
-        return [(t, b, str(getattr(k, "value", k)), p) for t, k, b, p in self.events]
+        return [(t, b, str(getattr(k, "value", k)), p) for t, b, k, p in self.events]
 
 
 def _starts_by_ball(contacts) -> dict:
