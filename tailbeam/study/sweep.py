@@ -49,11 +49,17 @@ WORKER_CONFIG = {
 #   that finishes a case starts the next at once instead of waiting ~1-4 ms for the scheduler
 #   to send it one (Dask's queuing, on by default, holds root tasks back on the scheduler);
 # - the scheduler's and nannies' system monitor (CPU, memory, disk and network counters for the
-#   dashboard, which a sweep does not start) every 2 s instead of every 0.5 s, without disk.
+#   dashboard, which a sweep does not start) every 2 s instead of every 0.5 s, without disk;
+# - the event-loop health tick (it only warns when a loop was blocked for seconds) every 0.2 s
+#   instead of 20 ms, and the nannies' check of their worker's memory every 0.5 s instead of
+#   0.1 s (a case takes ~0.4 GB of a limit of GBs). Together these periodic callbacks took
+#   ~10 % of the client process's event-loop CPU (yappi), which competes with the workers.
 SCHEDULER_CONFIG = {
     "distributed.scheduler.worker-saturation": float("inf"),
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.admin.system-monitor.disk": False,
+    "distributed.admin.tick.interval": "200ms",
+    "distributed.worker.memory.monitor-interval": "500ms",
 }
 
 
