@@ -38,7 +38,7 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
 
     Returns
     -------
-    tailbeam.result.Result
+    tailbeam.Result
         One interface for every solver: ``status``, ``message``, ``stats``, ``info``,
         ``impacts_table()`` (impacts.csv as numpy columns), ``particles_table()``
         (particles.csv), ``events_of(name, kind)``, ``impacts_of(name)``, ``leaves``,
