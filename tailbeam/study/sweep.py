@@ -43,19 +43,16 @@ WORKER_CONFIG = {
         "OPENBLAS_NUM_THREADS": 1,
     },
 }
-# the local scheduler, which shares the cores with the workers (a sweep's cases are
-# independent, short and all alike, so nothing is lost):
-# - worker-saturation inf: every case is sent to a worker as soon as it is ready, so a worker
-#   that finishes a case starts the next at once instead of waiting ~1-4 ms for the scheduler
-#   to send it one (Dask's queuing, on by default, holds root tasks back on the scheduler);
-# - the scheduler's and nannies' system monitor (CPU, memory, disk and network counters for the
-#   dashboard, which a sweep does not start) every 2 s instead of every 0.5 s, without disk;
+# the local scheduler and nannies, which share the cores with the workers:
+# - the system monitor (CPU, memory, disk and network counters for the dashboard, which a sweep
+#   does not start) every 2 s instead of every 0.5 s, without disk;
 # - the event-loop health tick (it only warns when a loop was blocked for seconds) every 0.2 s
 #   instead of 20 ms, and the nannies' check of their worker's memory every 0.5 s instead of
 #   0.1 s (a case takes ~0.4 GB of a limit of GBs). Together these periodic callbacks took
 #   ~10 % of the client process's event-loop CPU (yappi), which competes with the workers.
+# Dask's queuing stays on (worker-saturation 1.1): sending every case at once
+# (worker-saturation inf) made 1 worker faster and 2 workers slower (docs/datasets.md).
 SCHEDULER_CONFIG = {
-    "distributed.scheduler.worker-saturation": float("inf"),
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.admin.system-monitor.disk": False,
     "distributed.admin.tick.interval": "200ms",
@@ -82,7 +79,7 @@ def local_cluster(n_workers: int):
     from dask.distributed import LocalCluster
 
     # the scheduler is built here, in this process; the nannies pass the config to the workers
-    with dask.config.set({**WORKER_CONFIG, **SCHEDULER_CONFIG}):
+    with dask.config.set({**SCHEDULER_CONFIG, **WORKER_CONFIG}):
         return LocalCluster(
             n_workers=n_workers,
             threads_per_worker=1,
