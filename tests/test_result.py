@@ -118,7 +118,7 @@ def test_rigid_plate_columns_against_free_fall(rigid, rigid_scene):
 
 def test_rigid_columns_mean_what_the_stream_solver_writes(rigid, rigid_scene):
     """The same balls through the stream solver (its own records): every column of
-    impacts.csv and particles.csv agrees (the solvers' tolerances: rtol 1e-10 both)."""
+    impacts.csv and particles.csv agrees (rtol 1e-10 both; measured <= 1.3e-9 relative)."""
     scene = rigid_scene
     stream = stream_engine().run(
         scene.particles, scene.incline, scene.duration, laws=scene.contact, rtol=1e-10,
@@ -130,7 +130,7 @@ def test_rigid_columns_mean_what_the_stream_solver_writes(rigid, rigid_scene):
         if ours[c].dtype == object or c in ("index", "ends_at_rest"):
             assert list(ours[c]) == list(theirs[c]), c
         else:
-            assert ours[c] == pytest.approx(theirs[c], rel=1e-7, abs=1e-12), c
+            assert ours[c] == pytest.approx(theirs[c], rel=1e-8, abs=1e-12), c
     ours, theirs = rigid.particles_table(), stream.particles_table()
     for c in PARTICLE_COLUMNS:
         if ours[c].dtype == object:
