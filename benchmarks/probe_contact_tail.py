@@ -26,19 +26,26 @@ Kirchhoff, 2e-7 s Mindlin). Three parts, each prints a markdown table (a few min
 import argparse
 import sys
 from pathlib import Path
+from types import SimpleNamespace
+from unittest import mock
 
 import numpy as np
 from scipy import signal
-from scipy.linalg import eigh_tridiagonal
+from scipy.linalg import eigh, eigh_tridiagonal
 from scipy.special import sici
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from test_coupled_fe import IMPACT, REF_DT, _basis, _case  # noqa: E402
+from test_coupled_fe import IMPACT, REF_DT, SENSOR, R, _ball, _basis, _case  # noqa: E402
 
-from tailbeam.coupled.fe_reference import impact_quantities  # noqa: E402
+from tailbeam.bodies import Plate  # noqa: E402
+from tailbeam.contact_law import ball_plate_law  # noqa: E402
+from tailbeam.coupled.fe_compare import Case  # noqa: E402
+from tailbeam.coupled.fe_reference import FEImpact, impact_quantities  # noqa: E402
 from tailbeam.coupled.propagator import advance, coefficients  # noqa: E402
 from tailbeam.coupled.solver import simulate_coupled  # noqa: E402
+from tailbeam.materials import CARBON_STEEL, SANDSTONE  # noqa: E402
 from tailbeam.modal import ModalBasis  # noqa: E402
+from tailbeam.plate import assemble_plate, compute_modes, sparse_solve  # noqa: E402
 
 BANDS_HZ = (14e3, 20e3, 28e3)
 SHORT = {"restitution": "e", "peak_force": "F_max", "duration": "T", "max_penetration": "d_max"}
@@ -76,18 +83,46 @@ def tail_gauss(phi2, lam, k):
     """k pseudo-modes (omega, phi) of the tail measure sum phi2 delta(lam): Gauss quadrature in
     s = 1/lam of the weights phi2/lam (Lanczos), so sum phi^2/omega^(2m+2), m < 2k, match."""
     w, s = phi2 / lam, 1.0 / lam
-    vs, alpha, beta = [np.sqrt(w / w.sum())], [], []
+    alpha, beta = _lanczos(s, np.sqrt(w / w.sum()), k)
+    nodes, vecs = eigh_tridiagonal(alpha, beta)
+    lam_p = 1.0 / nodes
+    return np.sqrt(lam_p), np.sqrt(w.sum() * vecs[0] ** 2 * lam_p)
+
+
+def _lanczos(s, v0, k):
+    """Jacobi matrix (alpha (k,), beta (k-1,)) of diag(s) from the unit vector v0, fully
+    re-orthogonalised twice per step (stable for k up to a good fraction of len(s))."""
+    vs, alpha, beta = [v0], [], []
     for j in range(k):
         u = s * vs[-1]
-        for v in vs:  # full re-orthogonalisation (k is tiny)
-            u -= (v @ u) * v
-        alpha.append(vs[-1] @ (s * vs[-1]))
+        alpha.append(vs[-1] @ u)
+        for _ in range(2):
+            basis = np.array(vs)
+            u -= basis.T @ (basis @ u)
         if j < k - 1:
             beta.append(np.linalg.norm(u))
             vs.append(u / beta[-1])
-    nodes, vecs = eigh_tridiagonal(np.array(alpha), np.array(beta))
+    return np.array(alpha), np.array(beta)
+
+
+def stieltjes_gauss(phi2, lam, k):
+    """The same Gauss rule as ``tail_gauss`` by an independent route (check only): the
+    discretised Stieltjes procedure (three-term recurrence of the monic orthogonal polynomials
+    evaluated on the support, no re-orthogonalisation) in extended precision."""
+    w, s = (np.asarray(x, dtype=np.longdouble) for x in (phi2 / lam, 1.0 / lam))
+    p_prev, p = np.zeros_like(s), np.ones_like(s)
+    norm_prev, alpha, beta = None, [], []
+    for _ in range(k):
+        norm = np.sum(w * p * p)
+        alpha.append(np.sum(w * s * p * p) / norm)
+        b = 0.0 if norm_prev is None else norm / norm_prev
+        if norm_prev is not None:
+            beta.append(np.sqrt(b))
+        p_prev, p = p, (s - alpha[-1]) * p - b * p_prev
+        norm_prev = norm
+    nodes, vecs = eigh_tridiagonal(np.array(alpha, float), np.array(beta, float))
     lam_p = 1.0 / nodes
-    return np.sqrt(lam_p), np.sqrt(w.sum() * vecs[0] ** 2 * lam_p)
+    return np.sqrt(lam_p), np.sqrt(float(w.sum()) * vecs[0] ** 2 * lam_p)
 
 
 def with_pseudo_modes(basis, omega_p, phi_p):
@@ -104,7 +139,10 @@ def with_pseudo_modes(basis, omega_p, phi_p):
 
 
 def every_mode(theory, case):
-    full = _basis(theory, count=case.model.n_dofs)
+    """(phibar^2, omega^2) of every FE mode at the impact point (dense eigensolver: the test
+    meshes have 590 / 1679 DOFs, a few seconds)."""
+    with mock.patch.object(sparse_solve, "DENSE_LIMIT", max(case.model.n_dofs, 800)):
+        full = _basis(theory, count=case.model.n_dofs)
     return full.load_deflection([IMPACT], case.load_radius)[0] ** 2, full.omega**2
 
 
@@ -120,6 +158,189 @@ def part_pseudo(theory, case, ref):
             err = signed_errors(case, ref, with_pseudo_modes(basis, om_p, phi_p), 800)
             fp = ", ".join(f"{x / 2e3 / np.pi:.1f}" for x in np.sort(om_p))
             print(_row(f"{f / 1e3:.0f} kHz, {k} pseudo-mode(s) at {fp} kHz", err), flush=True)
+
+
+KS = (4, 8, 16, 24, 32)
+
+
+def _near_edge(omega_p, f_edge, width=5e3):
+    """'m nodes, max gap g kHz' of the pseudo-mode frequencies within ``width`` Hz of the edge."""
+    f = np.sort(np.append(omega_p / (2.0 * np.pi), f_edge))
+    f = f[f <= f_edge + width]
+    gap = np.max(np.diff(f)) / 1e3 if len(f) > 1 else np.nan
+    return f"{len(f) - 1} in +5 kHz, gap {gap:.1f} kHz"
+
+
+def part_gauss(theory, case, ref):
+    """k = 4..32 Gauss pseudo-modes of the exact tail, 200 and 800 steps per contact."""
+    phi2, lam = every_mode(theory, case)
+    _header("band, tail model, steps/contact")
+    for f in BANDS_HZ:
+        basis = _basis(theory, fmax_hz=f)
+        n = basis.n_modes
+        for spc in (200, 800):
+            err = signed_errors(case, ref, basis, spc)
+            print(_row(f"{f / 1e3:.0f} kHz ({n} modes), quasi-static, {spc}", err), flush=True)
+        for k in KS:
+            om_p, phi_p = tail_gauss(phi2[n:], lam[n:], k)
+            pseudo = with_pseudo_modes(basis, om_p, phi_p)
+            for spc in (200, 800):
+                err = signed_errors(case, ref, pseudo, spc)
+                label = f"{f / 1e3:.0f} kHz, k = {k} ({_near_edge(om_p, f)}), {spc}"
+                print(_row(label, err), flush=True)
+
+
+def bin_modes(phi2, lam, f_edge, bin_hz, window_hz):
+    """One pseudo-mode per frequency bin of width ``bin_hz`` from the band edge to
+    ``f_edge + window_hz`` (the bin's 1-node Gauss rule: its C1 and C2), or, for
+    ``bin_hz`` 0, every tail mode of the window itself. Modes above the window are left to
+    the quasi-static residual."""
+    f = np.sqrt(lam) / (2.0 * np.pi)
+    inside = f <= f_edge + window_hz
+    if bin_hz == 0:
+        return np.sqrt(lam[inside]), np.sqrt(phi2[inside])
+    which = np.floor((f[inside] - f_edge) / bin_hz).astype(int)
+    om, ph = [], []
+    for b in np.unique(which):
+        o, p = tail_gauss(phi2[inside][which == b], lam[inside][which == b], 1)
+        om.append(o[0])
+        ph.append(p[0])
+    return np.array(om), np.array(ph)
+
+
+def part_bins(theory, case, ref):
+    """The tail near the edge condensed into frequency bins (needs the spectrum: a probe of
+    the node spacing a pseudo-mode tail needs, not an implementable method)."""
+    phi2, lam = every_mode(theory, case)
+    _header("band, bins (width / window above the edge), steps/contact")
+    for f in BANDS_HZ:
+        basis = _basis(theory, fmax_hz=f)
+        n = basis.n_modes
+        for window, width in [(5e3, 0), (10e3, 0), (20e3, 0)] + [
+            (20e3, b) for b in (0.5e3, 1e3, 2e3, 4e3, 8e3)
+        ]:
+            om_p, phi_p = bin_modes(phi2[n:], lam[n:], f, width, window)
+            pseudo = with_pseudo_modes(basis, om_p, phi_p)
+            what = "every mode" if width == 0 else f"bins {width / 1e3:g} kHz"
+            for spc in (200, 800):
+                err = signed_errors(case, ref, pseudo, spc)
+                label = f"{f / 1e3:.0f} kHz, {what} to +{window / 1e3:g} kHz ({len(om_p)}), {spc}"
+                print(_row(label, err), flush=True)
+
+
+CONTACT_RECORD_S = 6e-4  # the --divisions reference: the first contact (ends at ~0.35 ms) only
+
+
+def mesh_case(theory, divisions):
+    """The test case on a ``divisions`` mesh (None: the test mesh)."""
+    if divisions is None:
+        return _case(theory)
+    model = assemble_plate(Plate(), "SSSS", theory=theory, divisions=divisions)
+    return Case(model, _ball(), ball_plate_law(SANDSTONE, R, CARBON_STEEL), SENSOR)
+
+
+def band_basis(theory, divisions, fmax_hz):
+    if divisions is None:
+        return _basis(theory, fmax_hz=fmax_hz)
+    return compute_modes(Plate(), "SSSS", theory=theory, divisions=divisions, fmax_hz=fmax_hz)
+
+
+def cached_reference(case, theory, divisions, cache):
+    """The FE reference: the test one (3.5 ms) on the test mesh, else the first contact only
+    (CONTACT_RECORD_S), read from / saved to the .npz ``cache`` when given."""
+    if divisions is None:
+        return case.reference(REF_DT[theory])
+    if cache is not None and Path(cache).exists():
+        data = np.load(cache)
+        print(f"reference read from {cache}", flush=True)
+        fields = {k: float(data[k]) for k in FEImpact.__dataclass_fields__}
+        return SimpleNamespace(t=data["t"], force=data["force"], impacts=[FEImpact(**fields)])
+    ref = case.reference(REF_DT[theory], duration=CONTACT_RECORD_S, max_work=1e14)
+    if cache is not None:
+        imp = ref.impacts[0]
+        fields = {k: getattr(imp, k) for k in FEImpact.__dataclass_fields__}
+        np.savez(cache, t=ref.t, force=ref.force, **fields)
+    return ref
+
+
+def ritz_modes(model, load, kept, k):
+    """k load-dependent Ritz pseudo-modes of the tail (Wilson-Yuan-Dickens): the Krylov space
+    of K^-1 M from the static residual K^-1 f - sum_kept phi phi^T f / omega^2, M-orthogonal to
+    the ``kept`` modes (n, m) (M-orthonormal) and re-orthogonalised twice, then Rayleigh-Ritz
+    on (K, M). In exact arithmetic this is the k-node Gauss rule of ``tail_gauss``.
+    Returns omega (k,) rad/s, the Ritz vectors Z (n, k) (unit modal mass) and f.Z (k,)."""
+    K, M, solve = model.stiffness, model.mass, model.solver().solve
+
+    def deflate(v, basis):
+        v = v - kept @ (kept.T @ (M @ v))
+        return v - basis @ (basis.T @ (M @ v))
+
+    V = np.zeros((len(load), k))
+    u = solve(load)
+    for j in range(k):
+        for _ in range(2):
+            u = deflate(u, V[:, :j])
+        V[:, j] = u / np.sqrt(u @ (M @ u))
+        u = solve(M @ V[:, j])
+    theta, Y = eigh(V.T @ (K @ V), V.T @ (M @ V))
+    Z = V @ Y
+    return np.sqrt(theta), Z, load @ Z
+
+
+def with_ritz_modes(basis, model, omega_p, Z):
+    """``basis`` plus Ritz pseudo-modes with their true shapes (seen at the sensor too)."""
+    parent = basis.deflection_at
+
+    def deflection_at(points):
+        extra = model.deflection_operator(np.atleast_2d(points)) @ Z
+        return np.column_stack([np.asarray(parent(points)), extra])
+
+    freqs = np.append(basis.frequencies_hz, omega_p / (2.0 * np.pi))
+    return ModalBasis(basis.plate, freqs, deflection_at, basis.theory, basis.boundary,
+                      basis.static_compliance_at, basis.static_deflection_at)  # fmt: skip
+
+
+def kept_modes(model, n):
+    """The n lowest M-orthonormal eigenvectors (n_dofs, n) of the FE model."""
+    lam, phi = sparse_solve.lowest_modes(model.stiffness, model.mass, n, shift=-1.0)
+    return lam, phi
+
+
+def part_ritz(theory, case, ref, divisions=None):
+    """Ritz pseudo-modes from K, M and the load vector only (no spectrum), in the solver; on the
+    test meshes also checked against the Gauss rule of the exact spectrum."""
+    model = case.model
+    load = model.load_vector(IMPACT, case.load_radius)
+    full = every_mode(theory, case) if model.n_dofs <= 2000 else None
+    _header("band, tail model, steps/contact")
+    for f in BANDS_HZ:
+        basis = band_basis(theory, divisions, f)
+        n = basis.n_modes
+        lam, kept = kept_modes(model, n)
+        gap = np.max(np.abs(np.sqrt(lam) / basis.omega - 1.0))
+        print(f"{f / 1e3:.0f} kHz: {n} kept modes, frequencies as compute_modes' to {gap:.1e}")
+        for spc in (200, 800):
+            err = signed_errors(case, ref, basis, spc)
+            print(_row(f"{f / 1e3:.0f} kHz ({n} modes), quasi-static, {spc}", err), flush=True)
+        for k in KS:
+            om_p, Z, phibar = ritz_modes(model, load, kept, k)
+            if full is not None:
+                print(_gauss_check(full, n, k, om_p, phibar))
+            pseudo = with_ritz_modes(basis, model, om_p, Z)
+            for spc in (200, 800):
+                err = signed_errors(case, ref, pseudo, spc)
+                label = f"{f / 1e3:.0f} kHz, Ritz k = {k} ({_near_edge(om_p, f)}), {spc}"
+                print(_row(label, err), flush=True)
+
+
+def _gauss_check(full, n, k, om_p, phibar):
+    """Largest relative difference of the Ritz pseudo-modes to the exact-spectrum Gauss rule."""
+    phi2, lam = full
+    om_g, ph_g = tail_gauss(phi2[n:], lam[n:], k)
+    i, j = np.argsort(om_p), np.argsort(om_g)
+    d_om = np.max(np.abs(om_p[i] / om_g[j] - 1.0))
+    d_ph = np.max(np.abs(np.abs(phibar[i]) / ph_g[j] - 1.0))
+    return f"  (k = {k}: Ritz vs exact-spectrum Gauss: omega {d_om:.1e}, |f.z| {d_ph:.1e})"
 
 
 def tail_response(t, force, omega, amp2):
@@ -171,13 +392,20 @@ def part_tail(theory, case, ref):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--theory", default="kirchhoff", choices=["kirchhoff", "mindlin"])
-    ap.add_argument("--part", default="steps", choices=["steps", "pseudo", "tail"])
+    parts = {"steps": part_steps, "pseudo": part_pseudo, "tail": part_tail, "gauss": part_gauss,
+             "bins": part_bins, "ritz": part_ritz}  # fmt: skip
+    ap.add_argument("--part", default="steps", choices=list(parts))
+    ap.add_argument("--divisions", type=int, help="--part ritz only: this mesh (e.g. 23)")
+    ap.add_argument("--ref-cache", help="--divisions only: .npz to read/save the FE reference")
     args = ap.parse_args()
-    case = _case(args.theory)
-    ref = case.reference(REF_DT[args.theory])
-    {"steps": part_steps, "pseudo": part_pseudo, "tail": part_tail}[args.part](
-        args.theory, case, ref
-    )
+    if args.divisions is not None and args.part != "ritz":
+        ap.error("--divisions: --part ritz only (the other parts need the test meshes)")
+    case = mesh_case(args.theory, args.divisions)
+    ref = cached_reference(case, args.theory, args.divisions, args.ref_cache)
+    if args.part == "ritz":
+        part_ritz(args.theory, case, ref, args.divisions)
+    else:
+        parts[args.part](args.theory, case, ref)
 
 
 if __name__ == "__main__":
