@@ -25,6 +25,7 @@ Kirchhoff, 2e-7 s Mindlin). Three parts, each prints a markdown table (a few min
 
 import argparse
 import sys
+import time
 from pathlib import Path
 from types import SimpleNamespace
 from unittest import mock
@@ -53,9 +54,10 @@ SHORT = {"restitution": "e", "peak_force": "F_max", "duration": "T", "max_penetr
 
 def signed_errors(case, ref, basis, steps_per_contact):
     """Signed relative errors of the first impact's four quantities (modal - FE) / FE."""
+    damping = {"rayleigh": case.rayleigh} if case.rayleigh != (0.0, 0.0) else {}
     res = simulate_coupled([case.ball], basis, [case.law], float(ref.t[-1]),
                            gravity=case.gravity, damping_ratio=0.0,
-                           steps_per_contact=steps_per_contact)  # fmt: skip
+                           steps_per_contact=steps_per_contact, **damping)  # fmt: skip
     q, q_ref = impact_quantities(res.impacts[0]), impact_quantities(ref.impacts[0])
     return {k: q[k] / q_ref[k] - 1.0 for k in q}
 
@@ -228,15 +230,18 @@ def part_bins(theory, case, ref):
                 print(_row(label, err), flush=True)
 
 
+RAYLEIGH = (60.0, 2e-7)  # tests/test_coupled_fe.py's Rayleigh case (alpha 1/s, beta s)
 CONTACT_RECORD_S = 6e-4  # the --divisions reference: the first contact (ends at ~0.35 ms) only
 
 
-def mesh_case(theory, divisions):
-    """The test case on a ``divisions`` mesh (None: the test mesh)."""
+def mesh_case(theory, divisions, rayleigh=(0.0, 0.0)):
+    """The test case on a ``divisions`` mesh (None: the test mesh), Rayleigh (alpha 1/s,
+    beta s) plate damping."""
     if divisions is None:
-        return _case(theory)
+        return _case(theory, rayleigh=rayleigh)
     model = assemble_plate(Plate(), "SSSS", theory=theory, divisions=divisions)
-    return Case(model, _ball(), ball_plate_law(SANDSTONE, R, CARBON_STEEL), SENSOR)
+    law = ball_plate_law(SANDSTONE, R, CARBON_STEEL)
+    return Case(model, _ball(), law, SENSOR, rayleigh=rayleigh)
 
 
 def band_basis(theory, divisions, fmax_hz):
@@ -306,31 +311,84 @@ def kept_modes(model, n):
     return lam, phi
 
 
-def part_ritz(theory, case, ref, divisions=None):
+def part_ritz(theory, case, ref, divisions=None, ks=KS):
     """Ritz pseudo-modes from K, M and the load vector only (no spectrum), in the solver; on the
     test meshes also checked against the Gauss rule of the exact spectrum."""
     model = case.model
-    load = model.load_vector(IMPACT, case.load_radius)
     full = every_mode(theory, case) if model.n_dofs <= 2000 else None
     _header("band, tail model, steps/contact")
     for f in BANDS_HZ:
         basis = band_basis(theory, divisions, f)
-        n = basis.n_modes
-        lam, kept = kept_modes(model, n)
+        lam, kept = kept_modes(model, basis.n_modes)
         gap = np.max(np.abs(np.sqrt(lam) / basis.omega - 1.0))
-        print(f"{f / 1e3:.0f} kHz: {n} kept modes, frequencies as compute_modes' to {gap:.1e}")
+        print(f"{f / 1e3:.0f} kHz: {basis.n_modes} kept modes, as compute_modes' to {gap:.1e}")
         for spc in (200, 800):
             err = signed_errors(case, ref, basis, spc)
-            print(_row(f"{f / 1e3:.0f} kHz ({n} modes), quasi-static, {spc}", err), flush=True)
-        for k in KS:
-            om_p, Z, phibar = ritz_modes(model, load, kept, k)
-            if full is not None:
-                print(_gauss_check(full, n, k, om_p, phibar))
-            pseudo = with_ritz_modes(basis, model, om_p, Z)
-            for spc in (200, 800):
-                err = signed_errors(case, ref, pseudo, spc)
-                label = f"{f / 1e3:.0f} kHz, Ritz k = {k} ({_near_edge(om_p, f)}), {spc}"
-                print(_row(label, err), flush=True)
+            label = f"{f / 1e3:.0f} kHz ({basis.n_modes} modes), quasi-static, {spc}"
+            print(_row(label, err), flush=True)
+        for k in ks:
+            _ritz_rows(case, ref, basis, f, kept, k, full)
+
+
+def _ritz_rows(case, ref, basis, f, kept, k, full):
+    """The solver with k Ritz pseudo-modes, 200 and 800 steps per contact; the label gives the
+    nodes near the edge and the a-posteriori change of the tail model from k to 2k."""
+    load = case.model.load_vector(IMPACT, case.load_radius)
+    om_p, Z, phibar = ritz_modes(case.model, load, kept, k)
+    om_2, _, phibar_2 = ritz_modes(case.model, load, kept, 2 * k)
+    if full is not None:
+        print(_gauss_check(full, basis.n_modes, k, om_p, phibar))
+    imp = ref.impacts[0]
+    change = tail_change((om_p, phibar), (om_2, phibar_2), imp.duration, imp.peak_force)
+    change /= imp.max_penetration
+    pseudo = with_ritz_modes(basis, case.model, om_p, Z)
+    for spc in (200, 800):
+        err = signed_errors(case, ref, pseudo, spc)
+        label = (
+            f"{f / 1e3:.0f} kHz, Ritz k = {k} ({_near_edge(om_p, f)}; k->2k {change:.1e}), {spc}"
+        )
+        print(_row(label, err), flush=True)
+
+
+def tail_change(model_a, model_b, duration, peak, steps=2000):
+    """RMS difference (m) of two pseudo-mode tails (omega (k,), f.z (k,)) over a half-sine
+    contact force of ``duration`` s and ``peak`` N."""
+    t = np.linspace(0.0, duration, steps + 1)
+    force = peak * np.sin(np.pi * t / duration)
+    wa, wb = (tail_response(t, force, om, ph**2) for om, ph in (model_a, model_b))
+    return float(np.sqrt(np.mean((wa - wb) ** 2)))
+
+
+def _best_time(fn, repeat=3):
+    """(result, best wall time s of ``repeat`` calls)."""
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return out, best
+
+
+def part_cost(theory, case, ref, divisions=None, ks=KS, band=20e3, spc=200):
+    """Speed against error at a 20 kHz band, default 200 steps/contact: the quasi-static
+    residual (baseline) and k Ritz pseudo-modes (their construction and the solver run;
+    best of 3 wall times, one core)."""
+    basis = band_basis(theory, divisions, band)
+    _, kept = kept_modes(case.model, basis.n_modes)
+    load = case.model.load_vector(IMPACT, case.load_radius)
+    print(f"| {theory}, {case.model.n_dofs} DOFs, {band / 1e3:.0f} kHz, {spc} steps/contact "
+          "| modes | Ritz build (s) | solver run (s) | max contact error |")  # fmt: skip
+    print("|---|---|---|---|---|")
+    err, run = _best_time(lambda: signed_errors(case, ref, basis, spc))
+    worst = max(abs(v) for v in err.values())
+    print(f"| quasi-static | {basis.n_modes} | - | {run:.2f} | {worst:.2e} |", flush=True)
+    for k in ks:
+        (om_p, Z, _), build = _best_time(lambda k=k: ritz_modes(case.model, load, kept, k))
+        pseudo = with_ritz_modes(basis, case.model, om_p, Z)
+        err, run = _best_time(lambda pseudo=pseudo: signed_errors(case, ref, pseudo, spc))
+        worst = max(abs(v) for v in err.values())
+        print(f"| Ritz k = {k} | {basis.n_modes + k} | {build:.3f} | {run:.2f} | {worst:.2e} |",
+              flush=True)  # fmt: skip
 
 
 def _gauss_check(full, n, k, om_p, phibar):
@@ -393,17 +451,29 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--theory", default="kirchhoff", choices=["kirchhoff", "mindlin"])
     parts = {"steps": part_steps, "pseudo": part_pseudo, "tail": part_tail, "gauss": part_gauss,
-             "bins": part_bins, "ritz": part_ritz}  # fmt: skip
+             "bins": part_bins, "ritz": part_ritz, "cost": part_cost}  # fmt: skip
     ap.add_argument("--part", default="steps", choices=list(parts))
-    ap.add_argument("--divisions", type=int, help="--part ritz only: this mesh (e.g. 23)")
+    ap.add_argument("--divisions", type=int, help="--part ritz/cost only: this mesh (e.g. 23)")
+    ap.add_argument(
+        "--ks",
+        type=int,
+        nargs="+",
+        default=list(KS),
+        help="--part ritz/cost only: the numbers of Ritz pseudo-modes",
+    )
+    ap.add_argument(
+        "--rayleigh",
+        action="store_true",
+        help="--part ritz only: Rayleigh plate damping alpha 60 1/s, beta 2e-7 s",
+    )
     ap.add_argument("--ref-cache", help="--divisions only: .npz to read/save the FE reference")
     args = ap.parse_args()
-    if args.divisions is not None and args.part != "ritz":
-        ap.error("--divisions: --part ritz only (the other parts need the test meshes)")
-    case = mesh_case(args.theory, args.divisions)
+    if (args.divisions is not None or args.rayleigh) and args.part not in ("ritz", "cost"):
+        ap.error("--divisions, --rayleigh: --part ritz/cost only (the others: test meshes)")
+    case = mesh_case(args.theory, args.divisions, RAYLEIGH if args.rayleigh else (0.0, 0.0))
     ref = cached_reference(case, args.theory, args.divisions, args.ref_cache)
-    if args.part == "ritz":
-        part_ritz(args.theory, case, ref, args.divisions)
+    if args.part in ("ritz", "cost"):
+        parts[args.part](args.theory, case, ref, args.divisions, args.ks)
     else:
         parts[args.part](args.theory, case, ref)
 
