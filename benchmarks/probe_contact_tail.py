@@ -1,10 +1,12 @@
 """Probe (issue 9): what limits the contact error at a 20 kHz band - the time step or the tail?
 
-    python benchmarks/probe_contact_tail.py [--theory kirchhoff|mindlin] [--part steps|pseudo|tail]
+    python benchmarks/probe_contact_tail.py [--theory kirchhoff|mindlin]
+        [--part steps|pseudo|tail|gauss|bins|ritz|cost|sensor] [--ks K ...]
+        [--divisions N --ref-cache FILE.npz] [--rayleigh]
 
 The case of tests/test_coupled_fe.py (Argyris 8x8 / Mindlin P4 6x6, SSSS, sandstone 30 mm at
 1 m/s, plate damping 0) against the full-FE reference (tailbeam.coupled.fe_reference, 1e-7 s
-Kirchhoff, 2e-7 s Mindlin). Three parts, each prints a markdown table (a few minutes each):
+Kirchhoff, 2e-7 s Mindlin). Each part prints a markdown table (seconds to a few minutes):
 
 - steps: SIGNED relative errors of the four contact quantities at 14/20/28 kHz for 200, 400,
   800 and 1600 steps per contact (the 1600 row is converged in time to ~1e-6: the band error;
@@ -13,9 +15,23 @@ Kirchhoff, 2e-7 s Mindlin). Three parts, each prints a markdown table (a few min
   (the k-node Gauss quadrature of the tail's spectral measure in 1/omega^2, i.e. Lanczos /
   load-dependent Ritz vectors of the tail: k = 1 matches sum phi^2/omega^2 and
   sum phi^2/omega^4). A probe, not a feature: the exact tail is taken from every FE mode
-  (Kirchhoff only: the 8x8 model's full spectrum) and the pseudo-modes are appended to the
-  basis with a shape that is non-zero only within 2 cm of the impact point (the sensor, 7 cm
-  away, does not see them; its quasi-static correction is unchanged).
+  (the test meshes' full spectra, dense) and the pseudo-modes are appended to the basis with a
+  shape that is non-zero only within 2 cm of the impact point (the sensor, 7 cm away, does
+  not see them; its quasi-static correction is unchanged).
+- gauss: the same with k = 4, 8, 16, 24, 32 nodes, 200 and 800 steps per contact (the label
+  gives how many nodes lie within 5 kHz above the band edge and their largest gap).
+- bins: the tail from the edge to +5/10/20 kHz kept mode by mode, or condensed into one
+  pseudo-mode per frequency bin of 0.5-8 kHz (+20 kHz window): the node spacing a pseudo-mode
+  tail needs (needs the spectrum; not an implementable method).
+- ritz: the implementable version, load-dependent Ritz vectors from K, M and the load vector
+  only (``ritz_modes``), with their true shapes; on the test meshes checked against the
+  exact-spectrum Gauss rule; ``--divisions 23`` runs the default Argyris mesh (reference of
+  the first contact only, ~3-5 min, saved to / read from ``--ref-cache``). The label gives
+  the a-posteriori change of the tail model from k to 2k pseudo-modes (RMS over a half-sine
+  contact force, relative to the maximum penetration). ``--rayleigh``: the Rayleigh case.
+- cost: speed against error at 20 kHz and 200 steps/contact, quasi-static baseline beside
+  k Ritz pseudo-modes (construction time and solver run time).
+- sensor: the in-band sensor error (fe_compare.modal_errors) with and without Ritz modes.
 - tail: offline, the tail's deflection at the contact under the reference's own force history,
   exact (every tail mode, exact propagation) against models of it: quasi-static C1 F; one
   pseudo-mode; a constant-density continuum above the band edge; and the damped filter
@@ -24,6 +40,7 @@ Kirchhoff, 2e-7 s Mindlin). Three parts, each prints a markdown table (a few min
 """
 
 import argparse
+import itertools
 import sys
 import time
 from pathlib import Path
@@ -40,7 +57,7 @@ from test_coupled_fe import IMPACT, REF_DT, SENSOR, R, _ball, _basis, _case  # n
 
 from tailbeam.bodies import Plate  # noqa: E402
 from tailbeam.contact_law import ball_plate_law  # noqa: E402
-from tailbeam.coupled.fe_compare import Case  # noqa: E402
+from tailbeam.coupled.fe_compare import Case, modal_errors  # noqa: E402
 from tailbeam.coupled.fe_reference import FEImpact, impact_quantities  # noqa: E402
 from tailbeam.coupled.propagator import advance, coefficients  # noqa: E402
 from tailbeam.coupled.solver import simulate_coupled  # noqa: E402
@@ -391,6 +408,27 @@ def part_cost(theory, case, ref, divisions=None, ks=KS, band=20e3, spc=200):
               flush=True)  # fmt: skip
 
 
+def part_sensor(theory, case, ref, divisions=None, ks=KS):
+    """The in-band sensor error (0-10 kHz, fe_compare.modal_errors, with its quasi-static
+    correction) and the contact error, quasi-static against k Ritz pseudo-modes with their
+    true shapes (seen at the sensor; the correction then subtracts their statics too).
+    Test meshes only (the reference records the sensor), 200 and 800 steps per contact."""
+    print("| band, tail model, steps/contact | contact | sensor | sensor without QS |")
+    print("|---|---|---|---|")
+    load = case.model.load_vector(IMPACT, case.load_radius)
+    for f in BANDS_HZ:
+        basis = band_basis(theory, divisions, f)
+        _, kept = kept_modes(case.model, basis.n_modes)
+        models = {"quasi-static": basis}
+        for k in ks:
+            om_p, Z, _ = ritz_modes(case.model, load, kept, k)
+            models[f"Ritz k = {k}"] = with_ritz_modes(basis, case.model, om_p, Z)
+        for (name, b), spc in itertools.product(models.items(), (200, 800)):
+            err = modal_errors(case, b, ref, steps_per_contact=spc)
+            print(f"| {f / 1e3:.0f} kHz, {name}, {spc} | {err['contact']:.2e} | "
+                  f"{err['sensor']:.2e} | {err['sensor_no_qs']:.2e} |", flush=True)  # fmt: skip
+
+
 def _gauss_check(full, n, k, om_p, phibar):
     """Largest relative difference of the Ritz pseudo-modes to the exact-spectrum Gauss rule."""
     phi2, lam = full
@@ -451,7 +489,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--theory", default="kirchhoff", choices=["kirchhoff", "mindlin"])
     parts = {"steps": part_steps, "pseudo": part_pseudo, "tail": part_tail, "gauss": part_gauss,
-             "bins": part_bins, "ritz": part_ritz, "cost": part_cost}  # fmt: skip
+             "bins": part_bins, "ritz": part_ritz, "cost": part_cost,
+             "sensor": part_sensor}  # fmt: skip
     ap.add_argument("--part", default="steps", choices=list(parts))
     ap.add_argument("--divisions", type=int, help="--part ritz/cost only: this mesh (e.g. 23)")
     ap.add_argument(
@@ -472,7 +511,7 @@ def main():
         ap.error("--divisions, --rayleigh: --part ritz/cost only (the others: test meshes)")
     case = mesh_case(args.theory, args.divisions, RAYLEIGH if args.rayleigh else (0.0, 0.0))
     ref = cached_reference(case, args.theory, args.divisions, args.ref_cache)
-    if args.part in ("ritz", "cost"):
+    if args.part in ("ritz", "cost", "sensor"):
         parts[args.part](args.theory, case, ref, args.divisions, args.ks)
     else:
         parts[args.part](args.theory, case, ref)
