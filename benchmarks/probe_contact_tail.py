@@ -24,7 +24,7 @@ Kirchhoff, 2e-7 s Mindlin). Each part prints a markdown table (seconds to a few 
   pseudo-mode per frequency bin of 0.5-8 kHz (+20 kHz window): the node spacing a pseudo-mode
   tail needs (needs the spectrum; not an implementable method).
 - ritz: the implementable version, load-dependent Ritz vectors from K, M and the load vector
-  only (``ritz_modes``), with their true shapes; on the test meshes checked against the
+  only (tailbeam.plate.ritz_tail), with their true shapes; on the test meshes checked against the
   exact-spectrum Gauss rule; ``--divisions 23`` runs the default Argyris mesh (reference of
   the first contact only, ~3-5 min, saved to / read from ``--ref-cache``). The label gives
   the a-posteriori change of the tail model from k to 2k pseudo-modes (RMS over a half-sine
@@ -49,7 +49,7 @@ from unittest import mock
 
 import numpy as np
 from scipy import signal
-from scipy.linalg import eigh, eigh_tridiagonal
+from scipy.linalg import eigh_tridiagonal
 from scipy.special import sici
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
@@ -64,6 +64,7 @@ from tailbeam.coupled.solver import simulate_coupled  # noqa: E402
 from tailbeam.materials import CARBON_STEEL, SANDSTONE  # noqa: E402
 from tailbeam.modal import ModalBasis  # noqa: E402
 from tailbeam.plate import assemble_plate, compute_modes, sparse_solve  # noqa: E402
+from tailbeam.plate.ritz_tail import ritz_tail_modes, with_ritz_tail  # noqa: E402
 
 BANDS_HZ = (14e3, 20e3, 28e3)
 SHORT = {"restitution": "e", "peak_force": "F_max", "duration": "T", "max_penetration": "d_max"}
@@ -291,53 +292,11 @@ def cached_reference(case, theory, custom, cache):
     return ref
 
 
-def ritz_modes(model, load, kept, k):
-    """k load-dependent Ritz pseudo-modes of the tail (Wilson-Yuan-Dickens): the Krylov space
-    of K^-1 M from the static residual K^-1 f - sum_kept phi phi^T f / omega^2, M-orthogonal to
-    the ``kept`` modes (n, m) (M-orthonormal) and re-orthogonalised twice, then Rayleigh-Ritz
-    on (K, M). In exact arithmetic this is the k-node Gauss rule of ``tail_gauss``.
-    Returns omega (k,) rad/s, the Ritz vectors Z (n, k) (unit modal mass) and f.Z (k,)."""
-    K, M, solve = model.stiffness, model.mass, model.solver().solve
-
-    def deflate(v, basis):
-        v = v - kept @ (kept.T @ (M @ v))
-        return v - basis @ (basis.T @ (M @ v))
-
-    V = np.zeros((len(load), k))
-    u = solve(load)
-    for j in range(k):
-        u_in = np.sqrt(u @ (M @ u))
-        for _ in range(2):
-            u = deflate(u, V[:, :j])
-        norm = np.sqrt(u @ (M @ u))
-        if norm < 1e-10 * u_in:  # the Krylov space of this load is exhausted
-            print(f"  (Ritz: the load's tail Krylov space has dimension {j} < k = {k})")
-            V = V[:, :j]
-            break
-        V[:, j] = u / norm
-        u = solve(M @ V[:, j])
-    theta, Y = eigh(V.T @ (K @ V), V.T @ (M @ V))
-    Z = V @ Y
-    return np.sqrt(theta), Z, load @ Z
-
-
-def with_ritz_modes(basis, model, omega_p, Z):
-    """``basis`` plus Ritz pseudo-modes with their true shapes (seen at the sensor too)."""
-    parent = basis.deflection_at
-
-    def deflection_at(points):
-        extra = model.deflection_operator(np.atleast_2d(points)) @ Z
-        return np.column_stack([np.asarray(parent(points)), extra])
-
-    freqs = np.append(basis.frequencies_hz, omega_p / (2.0 * np.pi))
-    return ModalBasis(basis.plate, freqs, deflection_at, basis.theory, basis.boundary,
-                      basis.static_compliance_at, basis.static_deflection_at)  # fmt: skip
-
-
-def kept_modes(model, n):
-    """The n lowest M-orthonormal eigenvectors (n_dofs, n) of the FE model."""
-    lam, phi = sparse_solve.lowest_modes(model.stiffness, model.mass, n, shift=-1.0)
-    return lam, phi
+def ritz_at_impact(basis, case, k):
+    """(omega (k,), f.z (k,)) of k Ritz pseudo-modes for the impact's load."""
+    load = case.model.load_vector(IMPACT, case.load_radius)
+    omega, Z = ritz_tail_modes(basis, load[:, None], k)
+    return omega, load @ Z
 
 
 def part_ritz(theory, case, ref, divisions=None, ks=KS):
@@ -348,29 +307,25 @@ def part_ritz(theory, case, ref, divisions=None, ks=KS):
     _header("band, tail model, steps/contact")
     for f in BANDS_HZ:
         basis = band_basis(theory, divisions, f)
-        lam, kept = kept_modes(model, basis.n_modes)
-        gap = np.max(np.abs(np.sqrt(lam) / basis.omega - 1.0))
-        print(f"{f / 1e3:.0f} kHz: {basis.n_modes} kept modes, as compute_modes' to {gap:.1e}")
         for spc in (200, 800):
             err = signed_errors(case, ref, basis, spc)
             label = f"{f / 1e3:.0f} kHz ({basis.n_modes} modes), quasi-static, {spc}"
             print(_row(label, err), flush=True)
         for k in ks:
-            _ritz_rows(case, ref, basis, f, kept, k, full)
+            _ritz_rows(case, ref, basis, f, k, full)
 
 
-def _ritz_rows(case, ref, basis, f, kept, k, full):
+def _ritz_rows(case, ref, basis, f, k, full):
     """The solver with k Ritz pseudo-modes, 200 and 800 steps per contact; the label gives the
     nodes near the edge and the a-posteriori change of the tail model from k to 2k."""
-    load = case.model.load_vector(IMPACT, case.load_radius)
-    om_p, Z, phibar = ritz_modes(case.model, load, kept, k)
-    om_2, _, phibar_2 = ritz_modes(case.model, load, kept, 2 * k)
+    om_p, phibar = ritz_at_impact(basis, case, k)
+    om_2, phibar_2 = ritz_at_impact(basis, case, 2 * k)
     if full is not None:
         print(_gauss_check(full, basis.n_modes, k, om_p, phibar))
     imp = ref.impacts[0]
     change = tail_change((om_p, phibar), (om_2, phibar_2), imp.duration, imp.peak_force)
     change /= imp.max_penetration
-    pseudo = with_ritz_modes(basis, case.model, om_p, Z)
+    pseudo = with_ritz_tail(basis, [IMPACT], case.load_radius, k)
     for spc in (200, 800):
         err = signed_errors(case, ref, pseudo, spc)
         label = (
@@ -403,8 +358,6 @@ def part_cost(theory, case, ref, divisions=None, ks=KS, band=20e3, spc=200):
     residual (baseline) and k Ritz pseudo-modes (their construction and the solver run;
     best of 3 wall times, one core)."""
     basis = band_basis(theory, divisions, band)
-    _, kept = kept_modes(case.model, basis.n_modes)
-    load = case.model.load_vector(IMPACT, case.load_radius)
     print(f"| {theory}, {case.model.n_dofs} DOFs, {band / 1e3:.0f} kHz, {spc} steps/contact "
           "| modes | Ritz build (s) | solver run (s) | max contact error |")  # fmt: skip
     print("|---|---|---|---|---|")
@@ -412,8 +365,7 @@ def part_cost(theory, case, ref, divisions=None, ks=KS, band=20e3, spc=200):
     worst = max(abs(v) for v in err.values())
     print(f"| quasi-static | {basis.n_modes} | - | {run:.2f} | {worst:.2e} |", flush=True)
     for k in ks:
-        (om_p, Z, _), build = _best_time(lambda k=k: ritz_modes(case.model, load, kept, k))
-        pseudo = with_ritz_modes(basis, case.model, om_p, Z)
+        pseudo, build = _best_time(lambda k=k: with_ritz_tail(basis, [IMPACT], case.load_radius, k))
         err, run = _best_time(lambda pseudo=pseudo: signed_errors(case, ref, pseudo, spc))
         worst = max(abs(v) for v in err.values())
         print(f"| Ritz k = {k} | {basis.n_modes + k} | {build:.3f} | {run:.2f} | {worst:.2e} |",
@@ -427,14 +379,11 @@ def part_sensor(theory, case, ref, divisions=None, ks=KS):
     Test meshes only (the reference records the sensor), 200 and 800 steps per contact."""
     print("| band, tail model, steps/contact | contact | sensor | sensor without QS |")
     print("|---|---|---|---|")
-    load = case.model.load_vector(IMPACT, case.load_radius)
     for f in BANDS_HZ:
         basis = band_basis(theory, divisions, f)
-        _, kept = kept_modes(case.model, basis.n_modes)
         models = {"quasi-static": basis}
         for k in ks:
-            om_p, Z, _ = ritz_modes(case.model, load, kept, k)
-            models[f"Ritz k = {k}"] = with_ritz_modes(basis, case.model, om_p, Z)
+            models[f"Ritz k = {k}"] = with_ritz_tail(basis, [IMPACT], case.load_radius, k)
         for (name, b), spc in itertools.product(models.items(), (200, 800)):
             err = modal_errors(case, b, ref, steps_per_contact=spc)
             print(f"| {f / 1e3:.0f} kHz, {name}, {spc} | {err['contact']:.2e} | "
