@@ -167,17 +167,10 @@ def every_mode(theory, case):
 
 
 def part_pseudo(theory, case, ref):
-    phi2, lam = every_mode(theory, case)
-    _header("band, tail model (800 steps/contact)")
-    for f in BANDS_HZ:
-        basis = _basis(theory, fmax_hz=f)
-        n = basis.n_modes
-        print(_row(f"{f / 1e3:.0f} kHz, quasi-static", signed_errors(case, ref, basis, 800)))
-        for k in (1, 2, 3, 4):
-            om_p, phi_p = tail_gauss(phi2[n:], lam[n:], k)
-            err = signed_errors(case, ref, with_pseudo_modes(basis, om_p, phi_p), 800)
-            fp = ", ".join(f"{x / 2e3 / np.pi:.1f}" for x in np.sort(om_p))
-            print(_row(f"{f / 1e3:.0f} kHz, {k} pseudo-mode(s) at {fp} kHz", err), flush=True)
+    def at(om_p, _f):
+        return "at " + ", ".join(f"{x / 2e3 / np.pi:.1f}" for x in np.sort(om_p)) + " kHz"
+
+    _gauss_table(theory, case, ref, (1, 2, 3, 4), (800,), at)
 
 
 KS = (4, 8, 16, 24, 32)
@@ -193,20 +186,26 @@ def _near_edge(omega_p, f_edge, width=5e3):
 
 def part_gauss(theory, case, ref):
     """k = 4..32 Gauss pseudo-modes of the exact tail, 200 and 800 steps per contact."""
+    _gauss_table(theory, case, ref, KS, (200, 800), _near_edge)
+
+
+def _gauss_table(theory, case, ref, ks, steps, describe):
+    """Rows of the quasi-static residual and of k-node Gauss tails (``describe(omega, band)``
+    labels the nodes) at each band and number of steps per contact."""
     phi2, lam = every_mode(theory, case)
     _header("band, tail model, steps/contact")
     for f in BANDS_HZ:
         basis = _basis(theory, fmax_hz=f)
         n = basis.n_modes
-        for spc in (200, 800):
+        for spc in steps:
             err = signed_errors(case, ref, basis, spc)
             print(_row(f"{f / 1e3:.0f} kHz ({n} modes), quasi-static, {spc}", err), flush=True)
-        for k in KS:
+        for k in ks:
             om_p, phi_p = tail_gauss(phi2[n:], lam[n:], k)
             pseudo = with_pseudo_modes(basis, om_p, phi_p)
-            for spc in (200, 800):
+            for spc in steps:
                 err = signed_errors(case, ref, pseudo, spc)
-                label = f"{f / 1e3:.0f} kHz, k = {k} ({_near_edge(om_p, f)}), {spc}"
+                label = f"{f / 1e3:.0f} kHz, k = {k} ({describe(om_p, f)}), {spc}"
                 print(_row(label, err), flush=True)
 
 
