@@ -7,9 +7,15 @@ import pytest
 from test_coupled_fe import IMPACT, _basis, _case
 
 from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities
+from tailbeam.coupled.propagator import advance, coefficients
 from tailbeam.coupled.solver import simulate_coupled
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.plate.ritz_tail import ritz_tail_modes, with_ritz_tail
+from tailbeam.plate.ritz_tail import (
+    choose_ritz_k,
+    half_sine_response,
+    ritz_tail_modes,
+    with_ritz_tail,
+)
 
 BAND = 20000.0
 
@@ -77,3 +83,38 @@ def test_ritz_tail_bad_input(kirchhoff):
         with_ritz_tail(basis.truncated(count=10), [IMPACT])
     with pytest.raises(WorkLimitError, match="lower k"):
         with_ritz_tail(basis, [IMPACT, (0.1, 0.1)], k=600)
+
+
+# the test contact of the FE reference (docs/fe-convergence.md): duration s, peak N, d_max m
+CONTACT = (332e-6, 2539.0, 8.98e-5)
+
+
+def test_half_sine_response_matches_exact_modal_propagation(kirchhoff):
+    # closed form against the solver's exact propagator for a piecewise-linear force
+    case, basis, _ = kirchhoff
+    f = case.model.load_vector(IMPACT)
+    omega, Z = ritz_tail_modes(basis, f[:, None], 16)
+    fz2, (duration, peak, _) = (Z.T @ f) ** 2, CONTACT
+    t = np.linspace(0.0, duration, 4001)
+    force = peak * np.sin(np.pi * t / duration)
+    coef, n = np.zeros((8, len(omega))), len(omega)
+    coefficients(omega, np.zeros(n), t[1] - t[0], coef)
+    q, qd, q1, qd1 = (np.zeros(n) for _ in range(4))
+    exact = np.zeros(len(t))
+    for j in range(len(t) - 1):
+        advance(coef, q, qd, np.full(n, force[j]), np.full(n, force[j + 1]), q1, qd1)
+        q, q1, qd, qd1 = q1, q, qd1, qd
+        exact[j + 1] = fz2 @ q
+    closed = half_sine_response(omega, np.sqrt(fz2), duration, peak, t)
+    assert np.max(np.abs(closed - exact)) < 1e-6 * np.max(np.abs(exact))
+
+
+def test_choose_ritz_k_doubles_until_the_tail_settles(kirchhoff):
+    # measured with the probe (reference force): k = 32 at 20 kHz, change 7.8e-6
+    case, basis, _ = kirchhoff
+    k, change = choose_ritz_k(basis, IMPACT, 0.0, *CONTACT)
+    assert k == 32 and change < 1e-5, (k, change)
+    with pytest.raises(WorkLimitError, match="k_max"):
+        choose_ritz_k(basis, IMPACT, 0.0, *CONTACT, tol=1e-9, k_max=64)
+    with pytest.raises(InputError, match="^duration:"):
+        choose_ritz_k(basis, IMPACT, 0.0, -1.0, 2539.0, 8.98e-5)
