@@ -4,10 +4,10 @@ against the full-FE impact reference of tests/test_coupled_fe.py."""
 
 import numpy as np
 import pytest
+from scipy import signal
 from test_coupled_fe import IMPACT, _basis, _case
 
 from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities
-from tailbeam.coupled.propagator import advance, coefficients
 from tailbeam.coupled.solver import simulate_coupled
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.plate.ritz_tail import (
@@ -89,22 +89,22 @@ def test_ritz_tail_bad_input(kirchhoff):
 CONTACT = (332e-6, 2539.0, 8.98e-5)
 
 
-def test_half_sine_response_matches_exact_modal_propagation(kirchhoff):
-    # closed form against the solver's exact propagator for a piecewise-linear force
+def test_half_sine_response_matches_a_state_space_integration(kirchhoff):
+    # closed form against scipy's linear simulation (first-order hold: exact for a
+    # piecewise-linear force) of the same undamped oscillators
     case, basis, _ = kirchhoff
     f = case.model.load_vector(IMPACT)
     omega, Z = ritz_tail_modes(basis, f[:, None], 16)
     fz2, (duration, peak, _) = (Z.T @ f) ** 2, CONTACT
     t = np.linspace(0.0, duration, 4001)
-    force = peak * np.sin(np.pi * t / duration)
-    coef, n = np.zeros((8, len(omega))), len(omega)
-    coefficients(omega, np.zeros(n), t[1] - t[0], coef)
-    q, qd, q1, qd1 = (np.zeros(n) for _ in range(4))
-    exact = np.zeros(len(t))
-    for j in range(len(t) - 1):
-        advance(coef, q, qd, np.full(n, force[j]), np.full(n, force[j + 1]), q1, qd1)
-        q, q1, qd, qd1 = q1, q, qd1, qd
-        exact[j + 1] = fz2 @ q
+    n = len(omega)
+    a = np.zeros((2 * n, 2 * n))
+    a[0::2, 1::2] = np.eye(n)
+    a[1::2, 0::2] = -np.diag(omega**2)
+    b = np.tile([[0.0], [1.0]], (n, 1))
+    c = np.zeros((1, 2 * n))
+    c[0, 0::2] = fz2
+    _, exact, _ = signal.lsim((a, b, c, [[0.0]]), peak * np.sin(np.pi * t / duration), t)
     closed = half_sine_response(omega, np.sqrt(fz2), duration, peak, t)
     assert np.max(np.abs(closed - exact)) < 1e-6 * np.max(np.abs(exact))
 
@@ -118,3 +118,5 @@ def test_choose_ritz_k_doubles_until_the_tail_settles(kirchhoff):
         choose_ritz_k(basis, IMPACT, 0.0, *CONTACT, tol=1e-9, k_max=64)
     with pytest.raises(InputError, match="^duration:"):
         choose_ritz_k(basis, IMPACT, 0.0, -1.0, 2539.0, 8.98e-5)
+    with pytest.raises(InputError, match="^k_max:"):
+        choose_ritz_k(basis, IMPACT, 0.0, *CONTACT, k_max=4096)
