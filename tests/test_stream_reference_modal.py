@@ -160,3 +160,49 @@ def test_fast_solver_converges_to_the_frozen_reference(references, basis, monkey
         assert fine < 1e-5 and fine < 0.2 * coarse and coarse < 0.1 * default
     else:
         assert fine < 0.2 * default
+
+
+def test_shape_gradients_match_the_closed_form(basis):
+    """The slope term's d phi / d(x, y) (central differences) against the derivative of
+    phi_mn = A sin(m pi (x + a/2) / a) sin(n pi (y + b/2) / b): within 1e-7 of max |grad|."""
+    plate = ReferencePlate(basis, 0.0)
+    a, b = basis.plate.size_x, basis.plate.size_y
+    m, n = basis.info["m"], basis.info["n"]
+    xy = np.array([[0.07, -0.05], [-0.21, 0.13], [0.29, 0.29]])
+    _, grad = plate.shapes_and_gradients(xy)
+    amp = 2.0 / np.sqrt(basis.plate.mass_per_area * a * b)
+    sx, cx = (
+        np.sin(m * np.pi * (xy[:, :1] + a / 2) / a),
+        np.cos(m * np.pi * (xy[:, :1] + a / 2) / a),
+    )
+    sy, cy = (
+        np.sin(n * np.pi * (xy[:, 1:] + b / 2) / b),
+        np.cos(n * np.pi * (xy[:, 1:] + b / 2) / b),
+    )
+    want = np.stack([amp * m * np.pi / a * cx * sy, amp * n * np.pi / b * sx * cy], axis=-1)
+    assert np.max(np.abs(grad - want)) < 1e-7 * np.max(np.abs(want))
+
+
+@pytest.mark.parametrize(
+    ("make", "field"),
+    [(lambda bs: ReferencePlate(bs, 1.5), "zeta"),
+     (lambda bs: ReferencePlate(bs, 0.0, "smooth"), "shapes"),
+     (lambda bs: "modal", "plate"),
+     (lambda bs: ReferencePlate(ssss_kirchhoff_basis(Plate(size_x=0.5), FMAX), 0.0), "plate")],
+)  # fmt: skip
+def test_bad_modal_input_names_the_field(basis, make, field):
+    from tailbeam.errors import InputError
+
+    ball = Ball("s", COAL, 0.02, (0.0, 0.0, 0.05))
+    with pytest.raises(InputError) as err:
+        simulate_stream_reference([ball], InclinedPlate(), 0.01, plate=make(basis))
+    assert err.value.field == field
+
+
+def test_too_long_a_modal_run_is_refused_before_it_starts(basis):
+    from tailbeam.errors import WorkLimitError
+
+    ball = Ball("s", COAL, 0.02, (0.0, 0.0, 0.05))
+    with pytest.raises(WorkLimitError, match="max_steps"):
+        simulate_stream_reference([ball], InclinedPlate(), 10.0, max_steps=1000,
+                                  plate=ReferencePlate(basis, 0.0))  # fmt: skip

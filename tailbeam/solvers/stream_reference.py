@@ -1,4 +1,5 @@
-"""Slow, independent reference for streams: all balls and a rigid inclined plate together.
+"""Slow, independent reference for streams: all balls and the inclined plate together, the
+plate rigid or modal (two-way, ``plate=ReferencePlate(...)``, see below).
 
 One ODE for every ball (3-D translation, frictionless, normal forces only, no rotation),
 integrated by scipy's DOP853 (the method of ``solve_ivp(method="DOP853")``, driven step by
@@ -26,6 +27,22 @@ straddled the kink can be late). Each event fires when its function passes a dea
 beyond zero (see ``_Reference.rows``), against round-off chatter at grazing contacts.
 Peak force and maximum penetration: the maximum of their Chebyshev interpolant on each
 step. Balls may enter later (``release_times``).
+
+Modal plate (``tailbeam.solvers.reference_plate``: the model, exact or frozen mode shapes).
+The state gains the modal coordinates [q | q'] after the balls (atol: deflections to rtol x
+1 mm, rates to rtol x 1 m/s). A ball's plate rows use the gap z - w, w = phi(x, y) . q.
+What is certified: with frozen shapes (a contact's) the rows are polynomials of degree
+<= 14 on a step, as above. With exact shapes phi(x(s), y(s)) is not a polynomial; the 15
+values are exact samples, and the certificate and the root search act on their
+interpolant. Every step is bounded so that no ball moves sideways more than 1 / k_max
+(k_max: the top mode's wavenumber; the step is redone shorter otherwise): along such a path
+each shape's Chebyshev coefficients fall like (k L / 4)^n / n!, and the interpolant misses
+the row only by products of them with the top coefficients of the dense output (~rtol):
+an estimate (~1e-12 of the row's scale), not a certificate. A crossing found on the
+interpolant is applied only where the true row lies within its dead band (else the step
+goes on and finds it again, closer), so no event is applied early; a dip narrower than
+that estimate could be missed. The modes also bound the steps (at least
+MODAL_STEPS_PER_PERIOD per period of the top mode: too long a run is refused at once).
 """
 
 import math
@@ -59,6 +76,7 @@ from tailbeam.solvers.step_events import (
 )
 
 SAME_TIME = 1e-9  # events closer than this (fraction of a step) are simultaneous
+MODAL_STEPS_PER_PERIOD = 5  # a lower bound of the steps per period of the top mode
 
 
 @dataclass
@@ -164,6 +182,7 @@ def simulate_stream_reference(
         if not isinstance(plate, ReferencePlate):
             raise InputError("plate", "must be a ReferencePlate (a modal basis and its damping)")
         plate.check_size(incline)
+        _check_modal_work(plate, duration, max_steps)
     sim = _Reference(balls, incline, options, rtol, max_steps, release, plate)
     sim.progress = progress
     return sim.run(duration)
@@ -755,6 +774,18 @@ def _same_switch(key, fresh) -> bool:
 def _law_table(pairs) -> _Laws:
     return _Laws(*(np.array([getattr(p.law, a) for p in pairs], dtype=float)
                    for a in ("stiffness", "exponent", "damping", "penetration")))  # fmt: skip
+
+
+def _check_modal_work(plate, duration, max_steps):
+    """The modes bound the steps: at least MODAL_STEPS_PER_PERIOD per period of the top mode
+    (measured 9-20 at rtol 1e-12); refuse a run that cannot fit max_steps before it starts."""
+    estimate = MODAL_STEPS_PER_PERIOD * duration * float(np.max(plate.omega)) / (2.0 * math.pi)
+    if estimate > max_steps:
+        raise WorkLimitError(
+            f"stream reference: the modal plate (top mode {np.max(plate.omega) / 2 / math.pi:.4g}"
+            f" Hz) needs at least ~{estimate:.3g} steps for {duration:g} s, above "
+            f"max_steps={max_steps}; raise max_steps, shorten the duration or keep fewer modes"
+        )
 
 
 def _release_times(release_times, n):
