@@ -259,6 +259,12 @@ class _Reference:
         if self.plate is not None:
             return self.modal_kinematics(pairs, x, v, modes)[:4]
         ix = pairs if isinstance(pairs, _PairIndex) else self.index(pairs)
+        return self.rigid_kinematics(ix, x, v)[:4]
+
+    @staticmethod
+    def rigid_kinematics(ix, x, v):
+        """``kinematics`` against the undeformed plate; also returns the balls i's centres
+        and velocities (..., P, 3) and the radius sums (..., P)."""
         li, lj, is_plate = ix.li, ix.lj, ix.is_plate
         xi, vi = x[..., li, :], v[..., li, :]
         foot = plate_foot(xi.reshape(-1, 3)).reshape(xi.shape)
@@ -266,20 +272,14 @@ class _Reference:
         vj = np.where(is_plate[:, None], 0.0, v[..., lj, :])
         rsum = np.broadcast_to(ix.radius_sum, xi.shape[:-1])
         kin = pair_kinematics(*(a.reshape(-1, 3) for a in (xi, vi, xj, vj)), rsum.reshape(-1))
-        return kin, li, lj, is_plate
+        return kin, li, lj, is_plate, xi, vi, rsum
 
     def modal_kinematics(self, pairs, x, v, modes):
         """``kinematics`` on the modal plate (``ReferencePlate.contact_geometry``): plate
         pairs' penetration and rate against the deflected plate; also returns their slope
         (P', 2) and shapes (P', m), flattened over the leading axes as the kinematics."""
         ix = pairs if isinstance(pairs, _PairIndex) else self.index(pairs)
-        li, lj, is_plate = ix.li, ix.lj, ix.is_plate
-        xi, vi = x[..., li, :], v[..., li, :]
-        xj = np.where(is_plate[:, None], plate_foot(xi.reshape(-1, 3)).reshape(xi.shape),
-                      x[..., lj, :])  # fmt: skip
-        vj = np.where(is_plate[:, None], 0.0, v[..., lj, :])
-        rsum = np.broadcast_to(ix.radius_sum, xi.shape[:-1])
-        kin = pair_kinematics(*(a.reshape(-1, 3) for a in (xi, vi, xj, vj)), rsum.reshape(-1))
+        kin, li, lj, is_plate, xi, vi, rsum = self.rigid_kinematics(ix, x, v)
         gap, rate, slope, phi = self.plate.contact_geometry(xi, vi, is_plate, ix.frozen_phi, modes)
         flat = np.broadcast_to(is_plate, rsum.shape).reshape(-1)
         kin = replace(
