@@ -206,3 +206,36 @@ def test_too_long_a_modal_run_is_refused_before_it_starts(basis):
     with pytest.raises(WorkLimitError, match="max_steps"):
         simulate_stream_reference([ball], InclinedPlate(), 10.0, max_steps=1000,
                                   plate=ReferencePlate(basis, 0.0))  # fmt: skip
+
+
+def test_gap_rows_are_polynomial_to_round_off_with_exact_shapes(basis, monkeypatch):
+    """With exact shapes the plate rows are not polynomials; on every accepted step of a
+    scene with oblique landings (one ball at 5 m/s sideways) their 15-point interpolant
+    matches the true row at 101 points to 1e-12 of r^2 (the docstring's estimate; measured
+    1.5e-14): what the certificate and root search rely on."""
+    from numpy.polynomial import chebyshev as cheb
+
+    from tailbeam.solvers import stream_reference as sr
+    from tailbeam.solvers.records import EventKind
+    from tailbeam.solvers.step_events import STEP_POINTS, chebyshev_coefficients
+
+    worst, detect = [], sr._Reference.detect
+    u = np.linspace(-1.0, 1.0, 101)
+    gaps = (EventKind.CONTACT_START, EventKind.CONTACT_END)
+
+    def checked(self, dense, t0, t1, fresh):
+        rows = [r for r in self.rows() if r[0][0] in gaps and r[0][1][1] == -1]
+        if rows and t1 > t0:
+            nodes = self.row_values(rows, *self.states_at(dense, t0 + STEP_POINTS * (t1 - t0)))
+            interp = cheb.chebval(u, chebyshev_coefficients(nodes).T)
+            true = self.row_values(rows, *self.states_at(dense, t0 + 0.5 * (u + 1) * (t1 - t0)))
+            r2 = np.array([self.pairs[r[0][1]].radius_sum ** 2 for r in rows])[:, None]
+            worst.append(float(np.max(np.abs(true - interp) / r2)))
+        return detect(self, dense, t0, t1, fresh)
+
+    monkeypatch.setattr(sr._Reference, "detect", checked)
+    balls = _four_balls() + [Ball("e", SANDSTONE, 0.02, (-0.25, 0.0, 0.03), (5.0, 0.0, -0.3))]
+    res = simulate_stream_reference(balls, InclinedPlate(), 0.025,
+                                    plate=ReferencePlate(basis, 0.0))  # fmt: skip
+    assert ("e", "plate") in {(c.ball, c.partner) for c in res.contacts}
+    assert len(worst) > 300 and max(worst) < 1e-12
