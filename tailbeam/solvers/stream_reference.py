@@ -38,10 +38,10 @@ interpolant. Every step is bounded so that no ball moves sideways more than 1 / 
 (k_max: the top mode's wavenumber; the step is redone shorter otherwise): along such a path
 each shape's Chebyshev coefficients fall like (k L / 4)^n / n!, and the interpolant misses
 the row only by products of them with the top coefficients of the dense output (~rtol):
-an estimate (~1e-12 of the row's scale; measured 1.5e-14 of r^2), not a certificate. A crossing found on the
-interpolant is applied only where the true row lies within its dead band (else the step
-goes on and finds it again, closer), so no event is applied early; a dip narrower than
-that estimate could be missed. The modes also bound the steps (at least
+an estimate (~1e-12 of the row's scale; measured 1.5e-14 of r^2), not a certificate. A
+crossing found on the interpolant is applied only where the true row lies within its dead
+band (else the step goes on and finds it again, closer), so no event is applied early; a
+dip narrower than that estimate could be missed. The modes also bound the steps (at least
 MODAL_STEPS_PER_PERIOD per period of the top mode: too long a run is refused at once).
 """
 
