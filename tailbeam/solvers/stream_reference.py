@@ -745,6 +745,9 @@ class _Reference:
     def result(self, duration):
         info = {
             "solver": f"stream reference: scipy DOP853 rtol={self.rtol:g}, restarted at kinks",
+            "plate": "rigid"
+            if self.plate is None
+            else f"modal, two-way: {self.plate.n_modes} modes, {self.plate.shapes} shapes",
             "duration": duration,
         }
         return StreamReferenceResult(
