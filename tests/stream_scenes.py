@@ -40,25 +40,6 @@ def ten_ball_scene(incline):
     ]
 
 
-def leave_scene(incline):
-    """Four balls on a steep incline that leave the plate (30 deg suits them):
-
-    - r1 sits at its static penetration and slides off the lower edge x+ (in contact all
-      along: its plate contact ends "left");
-    - r4 falls onto r1 (ball-ball contact while r1 touches the plate);
-    - r2 bounces across the plate and leaves over y+;
-    - r3 is thrown uphill and leaves over x- in flight.
-    """
-    r1 = 0.03
-    z1 = r1 - static_penetration_on(COAL, r1, incline)
-    return [
-        Ball("r1", COAL, r1, (0.15, 0.0, z1), (0.3, 0.0, 0.0)),
-        Ball("r2", SANDSTONE, 0.02, (0.0, 0.2, 0.05), (0.0, 0.8, -0.3)),
-        Ball("r3", COAL, 0.025, (-0.25, -0.1, 0.06), (-1.0, -0.3, 0.0)),
-        Ball("r4", SANDSTONE, 0.015, (0.16, 0.0, z1 + 0.06), (0.3, 0.0, -0.3)),
-    ]
-
-
 def modal_scene(incline):
     """Seven balls whose contacts all end within 28 ms (short runs of the slow reference
     on the modal plate, where the modes bound its steps):
@@ -80,4 +61,23 @@ def modal_scene(incline):
         Ball("s2", SANDSTONE, 0.02, (0.1, 0.1, 0.09), (0.0, 0.0, -0.5)),
         Ball("f1", SANDSTONE, 0.035, (-0.15, -0.2, 0.05), (0.3, 0.2, -2.0)),
         Ball("p1", COAL, 0.025, (0.2, -0.2, 0.05), (-0.2, 0.3, -1.5)),
+    ]
+
+
+def leave_scene(incline):
+    """Four balls on a steep incline that leave the plate (30 deg suits them):
+
+    - r1 sits at its static penetration and slides off the lower edge x+ (in contact all
+      along: its plate contact ends "left");
+    - r4 falls onto r1 (ball-ball contact while r1 touches the plate);
+    - r2 bounces across the plate and leaves over y+;
+    - r3 is thrown uphill and leaves over x- in flight.
+    """
+    r1 = 0.03
+    z1 = r1 - static_penetration_on(COAL, r1, incline)
+    return [
+        Ball("r1", COAL, r1, (0.15, 0.0, z1), (0.3, 0.0, 0.0)),
+        Ball("r2", SANDSTONE, 0.02, (0.0, 0.2, 0.05), (0.0, 0.8, -0.3)),
+        Ball("r3", COAL, 0.025, (-0.25, -0.1, 0.06), (-1.0, -0.3, 0.0)),
+        Ball("r4", SANDSTONE, 0.015, (0.16, 0.0, z1 + 0.06), (0.3, 0.0, -0.3)),
     ]
