@@ -54,6 +54,11 @@ SCENES = {
 GRAZE = 0.01  # contacts with a peak force below this fraction of the largest are grazes
 REFRESH = (1e-4, 1e-5, 1e-6)  # m: shape refresh and reuse distances of the fast solver
 DEFAULTS = (stream.SHAPE_TRAVEL, active_members.SHAPE_REUSE)
+DEFAULT_MARKERS = (  # (column, marker, style, legend) of the fast solver at its defaults
+    ("vs_frozen", "s", dict(ms=8, mfc="none"), "fast (defaults) vs frozen reference"),
+    ("vs_exact", "x", dict(ms=9, mew=2), "fast (defaults) vs exact reference"),
+    ("vs_exact_impacts", "+", dict(ms=11, mew=2), "same, impacts only (no grazes)"),
+)
 
 
 def reference(scene, basis, law, shapes, rtol=1e-12):
@@ -148,26 +153,9 @@ def plot(rows, path):
             ax.loglog(d, [r["vs_frozen"] for r in runs], "o-", color=color,
                       label=f"fast vs frozen reference, {label}")  # fmt: skip
             default = ref["fast, defaults (1 mm / 0.25 mm)"]
-            ax.loglog(
-                [DEFAULTS[0]],
-                [default["vs_frozen"]],
-                "s",
-                color=color,
-                ms=8,
-                mfc="none",
-                label=f"fast (defaults) vs frozen reference, {label}",
-            )
-            ax.loglog(
-                [DEFAULTS[0]],
-                [default["vs_exact"]],
-                "x",
-                color=color,
-                ms=9,
-                mew=2,
-                label=f"fast (defaults) vs exact reference, {label}",
-            )
-            ax.loglog([DEFAULTS[0]], [default["vs_exact_impacts"]], "+", color=color, ms=11,
-                      mew=2, label=f"same, impacts only (no grazes), {label}")  # fmt: skip
+            for key, marker, style, what in DEFAULT_MARKERS:
+                ax.loglog([DEFAULTS[0]], [default[key]], marker, color=color,
+                          label=f"{what}, {label}", **style)  # fmt: skip
             ax.axhline(ref["reference, exact shapes"]["vs_frozen"], color=color, ls="--",
                        label=f"exact vs frozen reference, {label}")  # fmt: skip
             ax.axhline(ref["reference, frozen, rtol 1e-13"]["vs_frozen"], color=color, ls=":",
