@@ -6,6 +6,10 @@ set is rebuilt on the next ``advance`` after a change, carrying over each pair's
 (touching, region flags, peak force, maximum penetration) by its key: (i, -1) for ball i on
 the plate, (i, j) with i < j for two balls. Every pair among the members is watched (sets are
 small: the balls near a contact).
+
+On the modal plate each plate pair also gets the residual compliance (m/N) of the truncated
+modes at its contact point (``StreamPlate.compliance``), computed and cached with its mode
+shapes and carried over with them.
 """
 
 import math
@@ -13,8 +17,9 @@ import math
 import numpy as np
 
 from tailbeam.contact_law import ball_ball_law
+from tailbeam.contact_patch import load_radius
 from tailbeam.physics.incline import EDGES
-from tailbeam.solvers.active_pairs import elastic_energy, first_contact_step, settle_excess
+from tailbeam.solvers.active_pairs import L_CRES, first_contact_step, settle_excess
 from tailbeam.solvers.active_set import ActiveSet, law_table
 
 SHAPE_REUSE = 2.5e-4  # m: mode shapes computed within this distance are reused (modal plate)
@@ -39,7 +44,8 @@ class ActiveMembers:
         self._laws = {}
         self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
         self.totals = {"kernel_steps": 0, "kernel_attempts": 0, "kernel_nfev": 0, "rebuilds": 0}
-        self._shape_cache = {}  # ball -> (xy, mode shapes there): modal plate
+        self._shape_cache = {}  # ball -> (xy, mode shapes there, residual compliance there)
+        self._load_radii = {}  # ball -> radius (m) of its load model (contact_patch)
         self._x = {}  # state of members added since the last build
         self._v = {}
 
@@ -69,6 +75,7 @@ class ActiveMembers:
         self._pairs = {k: self._pair_state(p) for k, p in self.index.items()}
         if self.plate is not None:  # each plate pair keeps its mode shapes (its contact point)
             self._phi = {k: self.set.phi[p].copy() for k, p in self.index.items() if k[1] < 0}
+            self._cres = {k: self.set.law[p, L_CRES] for k, p in self.index.items() if k[1] < 0}
 
     def _pair_state(self, p):
         s = self.set
@@ -120,21 +127,40 @@ class ActiveMembers:
             return {}
         plate.propagate(self.now)
         plate.set_dead_loads(*self.dead_loads())
-        kept = getattr(self, "_phi", {})
+        kept, kept_c = getattr(self, "_phi", {}), getattr(self, "_cres", {})
         new = [i for i in members if (i, -1) not in kept]
-        shapes = dict(zip(new, self._shapes(new, [self._x[i][:2] for i in new]), strict=True))
+        new_phi, new_c = self._shapes(new, [self._x[i][:2] for i in new])
+        shapes = {i: (new_phi[k], new_c[k]) for k, i in enumerate(new)}
         phi = np.zeros((len(self.keys), plate.n_modes))
+        cres = np.zeros(len(self.keys))
         for q, i in enumerate(members):  # the plate pairs come first, in member order
-            phi[q] = kept[(i, -1)] if (i, -1) in kept else shapes[i]
+            key = (i, -1)
+            phi[q], cres[q] = (kept[key], kept_c[key]) if key in kept else shapes[i]
         for q, i in enumerate(members):
             if i in self.quiet:
-                self._x[i][2] = self.balls.radius[i] - self.balls.static_pen[i] + phi[q] @ plate.q
+                self._x[i][2] = self._static_height(i, cres[q]) + phi[q] @ plate.q
         atol_x = self.rtol * 1e-3
         scale = float(np.max(plate.phi_max))
         return dict(
             omega=plate.omega, zeta=plate.zeta, q=plate.q, qd=plate.qd, phi=phi,
             f_dead=plate.f_dead, atol_q=atol_x / scale, atol_qd=self.rtol / scale,
+            compliance=cres,
         )  # fmt: skip
+
+    def _static_height(self, i: int, cres: float) -> float:
+        """Height (m) of ball i resting on the undeflected plate: its static penetration,
+        plus the residual spring's C m g_n in series (modal plate)."""
+        b = self.balls
+        return b.radius[i] - b.static_pen[i] - cres * b.mass[i] * -b.g[2]
+
+    def _load_radius(self, i: int) -> float:
+        """Radius (m) of the disc ball i's force is spread over in the residual compliance
+        (tailbeam.contact_patch: 0 on a Kirchhoff basis; the Hertz radius on Mindlin)."""
+        if i not in self._load_radii:
+            b = self.balls
+            self._load_radii[i] = load_radius(self.plate.basis.theory, b.particles[i].ball(),
+                                              b.plate_laws[i], float(-b.g[2]))  # fmt: skip
+        return self._load_radii[i]
 
     def refresh_shapes(self):
         """Modal plate: the mode shapes of every plate pair not touching, at its ball's
@@ -145,33 +171,38 @@ class ActiveMembers:
         free = [(q, i) for q, i in enumerate(self.members) if not s.touching[self.index[(i, -1)]]]
         if not free:
             return
-        shapes = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
-        for (_, i), shape in zip(free, shapes, strict=True):
+        shapes, cres = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
+        for (_, i), shape, c in zip(free, shapes, cres, strict=True):
             p = self.index[(i, -1)]
             # only where the change of the plate under the ball cannot close its gap (a
             # ball just off the plate keeps its shapes: no start or end out of nothing)
             gap = -s.penetration(p)[0]
             if gap > abs((shape - s.phi[p]) @ s.q) + 1e-9:
                 s.set_phi(p, shape)
+                s.set_compliance(p, c)
 
-    def _shapes(self, balls, xy) -> np.ndarray:
-        """Mode shapes under ``balls`` at ``xy``: each ball's cached row unless it moved more
-        than SHAPE_REUSE since it was computed (one batched evaluation for the rest)."""
+    def _shapes(self, balls, xy) -> tuple[np.ndarray, np.ndarray]:
+        """Mode shapes (len, m) and residual compliances (len,) m/N under ``balls`` at ``xy``:
+        each ball's cached ones unless it moved more than SHAPE_REUSE since they were
+        computed (one batched evaluation of the shapes for the rest)."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
         out = np.empty((len(balls), self.plate.n_modes))
+        cres = np.empty(len(balls))
         todo = []
         for k, i in enumerate(balls):
             cached = self._shape_cache.get(i)
             if cached is not None and np.hypot(*(cached[0] - xy[k])) <= SHAPE_REUSE:
-                out[k] = cached[1]
+                out[k], cres[k] = cached[1], cached[2]
             else:
                 todo.append(k)
         if todo:
             fresh = self.plate.shapes(xy[todo])
-            for k, row in zip(todo, fresh, strict=True):
-                out[k] = row
-                self._shape_cache[balls[k]] = (xy[k].copy(), row)
-        return out
+            radii = [self._load_radius(balls[k]) for k in todo]
+            fresh_c = self.plate.compliance(xy[todo], radii)
+            for k, row, c in zip(todo, fresh, fresh_c, strict=True):
+                out[k], cres[k] = row, c
+                self._shape_cache[balls[k]] = (xy[k].copy(), row, c)
+        return out, cres
 
     def _count(self):
         if self.set is not None:
@@ -252,11 +283,7 @@ class ActiveMembers:
         s = self._ready()
         q = [self.local[int(i)] for i in balls]
         kinetic = 0.5 * float(np.sum(s.mass[q] * np.sum(s.v[q] * s.v[q], axis=1)))
-        elastic = 0.0
-        for p in np.flatnonzero(s.touching):
-            delta, _ = s.penetration(p)
-            k, e = s.law[p, 0], s.law[p, 1]
-            elastic += elastic_energy(delta, k, e)
+        elastic = sum(s.contact_energy(p) for p in np.flatnonzero(s.touching))
         return kinetic + elastic
 
     def elastic_energy_of(self, i: int) -> float:
@@ -265,11 +292,8 @@ class ActiveMembers:
         s = self._ready()
         total = 0.0
         for key in self.touching_pairs(i):
-            p = self.index[key]
-            delta, _ = s.penetration(p)
-            k, e = s.law[p, 0], s.law[p, 1]
             share = 1.0 if key[1] < 0 else 0.5
-            total += share * elastic_energy(delta, k, e)
+            total += share * s.contact_energy(self.index[key])
         return total
 
     def touching_pairs(self, i: int) -> list:
@@ -306,7 +330,7 @@ class ActiveMembers:
         if not s.touching[p]:  # a slow rebound: the energy of the normal motion above rest
             removed = 0.5 * s.mass[q] * s.v[q, 2] ** 2
         w, wd = (s.phi[p] @ s.q, s.phi[p] @ s.qd) if self.plate is not None else (0.0, 0.0)
-        s.x[q, 2] = self.balls.radius[i] - self.balls.static_pen[i] + w
+        s.x[q, 2] = self._static_height(i, s.law[p, L_CRES]) + w
         s.v[q, 2] = wd
         law = s.law[p]
         s.touching[p] = True
