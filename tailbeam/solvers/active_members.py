@@ -8,8 +8,9 @@ the plate, (i, j) with i < j for two balls. Every pair among the members is watc
 small: the balls near a contact).
 
 On the modal plate each plate pair also gets the residual compliance (m/N) of the truncated
-modes at its contact point (``StreamPlate.compliance``), computed and cached with its mode
-shapes and carried over with them.
+modes at the point of its mode shapes (``StreamPlate.compliance``, cached by point): when its
+contact starts (the force is 0 then, so nothing jumps) or it is put at rest; carried over
+with the shapes while it touches.
 """
 
 import math
@@ -44,7 +45,8 @@ class ActiveMembers:
         self._laws = {}
         self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
         self.totals = {"kernel_steps": 0, "kernel_attempts": 0, "kernel_nfev": 0, "rebuilds": 0}
-        self._shape_cache = {}  # ball -> (xy, mode shapes there, residual compliance there)
+        self._shape_cache = {}  # ball -> (xy, mode shapes there): modal plate
+        self._phi_xy = {}  # plate pair key -> the point (x, y) of its mode shapes
         self._load_radii = {}  # ball -> radius (m) of its load model (contact_patch)
         self._x = {}  # state of members added since the last build
         self._v = {}
@@ -76,6 +78,7 @@ class ActiveMembers:
         if self.plate is not None:  # each plate pair keeps its mode shapes (its contact point)
             self._phi = {k: self.set.phi[p].copy() for k, p in self.index.items() if k[1] < 0}
             self._cres = {k: self.set.law[p, L_CRES] for k, p in self.index.items() if k[1] < 0}
+            self._phi_xy = {k: xy for k, xy in self._phi_xy.items() if k in self._phi}
 
     def _pair_state(self, p):
         s = self.set
@@ -129,15 +132,16 @@ class ActiveMembers:
         plate.set_dead_loads(*self.dead_loads())
         kept, kept_c = getattr(self, "_phi", {}), getattr(self, "_cres", {})
         new = [i for i in members if (i, -1) not in kept]
-        new_phi, new_c = self._shapes(new, [self._x[i][:2] for i in new])
-        shapes = {i: (new_phi[k], new_c[k]) for k, i in enumerate(new)}
+        new_phi, new_xy = self._shapes(new, [self._x[i][:2] for i in new])
+        shapes = dict(zip(new, new_phi, strict=True))
+        self._phi_xy.update({(i, -1): new_xy[k] for k, i in enumerate(new)})
         phi = np.zeros((len(self.keys), plate.n_modes))
         cres = np.zeros(len(self.keys))
         for q, i in enumerate(members):  # the plate pairs come first, in member order
             key = (i, -1)
-            phi[q], cres[q] = (kept[key], kept_c[key]) if key in kept else shapes[i]
-        for q, i in enumerate(members):
+            phi[q], cres[q] = (kept[key], kept_c[key]) if key in kept else (shapes[i], 0.0)
             if i in self.quiet:
+                cres[q] = self._compliance(key)
                 self._x[i][2] = self._static_height(i, cres[q]) + phi[q] @ plate.q
         atol_x = self.rtol * 1e-3
         scale = float(np.max(plate.phi_max))
@@ -171,38 +175,47 @@ class ActiveMembers:
         free = [(q, i) for q, i in enumerate(self.members) if not s.touching[self.index[(i, -1)]]]
         if not free:
             return
-        shapes, cres = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
-        for (_, i), shape, c in zip(free, shapes, cres, strict=True):
+        shapes, points = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
+        for (_, i), shape, xy in zip(free, shapes, points, strict=True):
             p = self.index[(i, -1)]
             # only where the change of the plate under the ball cannot close its gap (a
             # ball just off the plate keeps its shapes: no start or end out of nothing)
             gap = -s.penetration(p)[0]
             if gap > abs((shape - s.phi[p]) @ s.q) + 1e-9:
                 s.set_phi(p, shape)
-                s.set_compliance(p, c)
+                s.set_compliance(p, 0.0)  # (set when its contact starts)
+                self._phi_xy[(i, -1)] = xy
+
+    def _compliance(self, key) -> float:
+        """Residual compliance (m/N) of plate pair ``key`` at the point of its mode shapes."""
+        i = key[0]
+        return float(self.plate.compliance([self._phi_xy[key]], [self._load_radius(i)])[0])
+
+    def _set_compliance(self, key):
+        """Modal plate: plate pair ``key`` (touching from now) gets its residual compliance."""
+        if self.plate is not None and key[1] < 0:
+            self.set.set_compliance(self.index[key], self._compliance(key))
 
     def _shapes(self, balls, xy) -> tuple[np.ndarray, np.ndarray]:
-        """Mode shapes (len, m) and residual compliances (len,) m/N under ``balls`` at ``xy``:
-        each ball's cached ones unless it moved more than SHAPE_REUSE since they were
-        computed (one batched evaluation of the shapes for the rest)."""
+        """Mode shapes (len, m) under ``balls`` at ``xy`` and the points (len, 2) they were
+        computed at: each ball's cached row unless it moved more than SHAPE_REUSE since it
+        was computed (one batched evaluation for the rest)."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
         out = np.empty((len(balls), self.plate.n_modes))
-        cres = np.empty(len(balls))
+        points = xy.copy()
         todo = []
         for k, i in enumerate(balls):
             cached = self._shape_cache.get(i)
             if cached is not None and np.hypot(*(cached[0] - xy[k])) <= SHAPE_REUSE:
-                out[k], cres[k] = cached[1], cached[2]
+                points[k], out[k] = cached
             else:
                 todo.append(k)
         if todo:
             fresh = self.plate.shapes(xy[todo])
-            radii = [self._load_radius(balls[k]) for k in todo]
-            fresh_c = self.plate.compliance(xy[todo], radii)
-            for k, row, c in zip(todo, fresh, fresh_c, strict=True):
-                out[k], cres[k] = row, c
-                self._shape_cache[balls[k]] = (xy[k].copy(), row, c)
-        return out, cres
+            for k, row in zip(todo, fresh, strict=True):
+                out[k] = row
+                self._shape_cache[balls[k]] = (xy[k].copy(), row)
+        return out, points
 
     def _count(self):
         if self.set is not None:
@@ -232,6 +245,8 @@ class ActiveMembers:
         if kind is None:
             return None, None, out.t
         if kind in ("start", "end"):
+            if kind == "start":
+                self._set_compliance(self.keys[out.index])
             return kind, self.keys[out.index], out.t
         ball = self.members[out.index]
         return kind, (ball, EDGES[out.edge]) if kind == "leave" else ball, out.t
@@ -307,6 +322,7 @@ class ActiveMembers:
         delta, _ = s.penetration(p)
         s.touching[p], s.ramp[p], s.clamped[p] = True, True, False
         s.peak[p], s.t_peak[p], s.pen[p] = 0.0, math.nan, max(delta, 0.0)
+        self._set_compliance(key)
         step = first_contact_step(s.y, s.model(), p, self.rtol)
         self.h = min(self.h, step) if self.h else step
 
@@ -330,6 +346,7 @@ class ActiveMembers:
         if not s.touching[p]:  # a slow rebound: the energy of the normal motion above rest
             removed = 0.5 * s.mass[q] * s.v[q, 2] ** 2
         w, wd = (s.phi[p] @ s.q, s.phi[p] @ s.qd) if self.plate is not None else (0.0, 0.0)
+        self._set_compliance((i, -1))
         s.x[q, 2] = self._static_height(i, s.law[p, L_CRES]) + w
         s.v[q, 2] = wd
         law = s.law[p]
