@@ -144,9 +144,8 @@ def _basis_and_damping(scene, band):
 
 def _stream_plate(scene, band):
     """The two-way modal plate of a stream scene (tailbeam.solvers.stream_plate)."""
-    from tailbeam.solvers.stream_plate import StreamPlate
-
     from tailbeam.scene import ModalPlateSettings
+    from tailbeam.solvers.stream_plate import StreamPlate
 
     basis, zeta = _basis_and_damping(scene, band)
     settings = scene.modal or ModalPlateSettings()

@@ -13,7 +13,8 @@ point, 1/sqrt(kg); rows of ball-ball pairs unused):
     ball-plate: delta = r_i - (z_i - w),          n = (0, 0, 1), rate with w' = phi[p] . q'
 
 Modes: q'' + 2 zeta omega q' + omega^2 q = f_dead - sum over touching plate pairs phi[p] F_p
-(F_p on the ball along +z, its reaction -F_p on the plate).
+(F_p on the ball along +z, its reaction -F_p on the plate);
+    rate = -(v_i - v_j) . n  (> 0 approaching); force F n on i, -F n on j (frictionless).
 
 Residual flexibility (optional, per plate pair: ``law[p, L_CRES]`` = C m/N, the static
 compliance of the truncated modes at the contact point, 0 = none): the law acts on the
@@ -21,10 +22,10 @@ penetration left after the residual spring in series, F = IMPACT(delta, delta'),
 delta = delta0 - C F (delta0 = r - (z - w) as above), solved per evaluation by
 ``plate_force_with_residual``. Contact start and end stay the crossings of delta0 = 0 (F = 0
 there); the full-damping and clamp rows use delta and F.
-    rate = -(v_i - v_j) . n  (> 0 approaching); force F n on i, -F n on j (frictionless).
 
 ``law`` (P, 6) columns: stiffness k (N/m^e), exponent e, damping c (N s/m), penetration d (m),
-clamp (0/1), residual compliance C (m/N, plate pairs; 0 otherwise), built by ``contact_law.ball_ball_law`` / ``ball_plate_law``. ``region_force``
+clamp (0/1), residual compliance C (m/N, plate pairs; 0 otherwise), built by
+``contact_law.ball_ball_law`` / ``ball_plate_law``. ``region_force``
 and ``clamp_indicator`` are the numba twins of ``contact_law.impact_force_in_region`` and
 ``contact_law.clamp_indicator`` (tests/test_contact_law_regions.py checks them).
 

@@ -92,18 +92,18 @@ def pair_laws(balls, pairs, plate_material, **options):
 class ActiveSet:
     """n balls and P watched pairs, advanced by the compiled kernel.
 
-    x, v: (n, 3) positions (m) and velocities (m/s), views of the state (in/out); mass (n,)
-    kg; radius (n,) m; pairs: (P, 2) ball indices (j = -1: the plate); laws: P ``ImpactLaw``s
-    (or a (P, 5) ``law_table``; stored as (P, 6) with the compliance); gravity (3,) m/s^2 in the plate frame; half_sizes (a/2, b/2)
-    m; settle_energy (n,) J (0 = never); rtol; atol_x (m), atol_v (m/s) (default rtol x 1 mm,
-    rtol x 1 m/s, as the reference); max_steps per ``advance`` call; nodes_per_step: interior force
-    rows per step. Modal plate (optional, all m modes): omega (m,) rad/s, zeta (m,), q, qd (m,)
-    initial modal state (m sqrt(kg), m sqrt(kg)/s; default 0), phi (P, m) mode shapes at each
-    pair's contact point in 1/sqrt(kg) (rows of ball-ball pairs ignored; ``set_phi`` changes
-    a row for a new contact), f_dead (m,) constant modal forces in N/sqrt(kg) (balls resting
-    quasi-statically elsewhere); atol_q, atol_qd (default atol_x / s, atol_v / s with
-    s = max |phi| at construction, so that the deflection under a ball is held to about
-    atol_x; pass them when phi is only set later); compliance (P,) m/N: the residual
+    x, v: (n, 3) positions (m) and velocities (m/s), views of the state (in/out); mass (n,) kg;
+    radius (n,) m; pairs: (P, 2) ball indices (j = -1: the plate); laws: P ``ImpactLaw``s (or a
+    (P, 5) ``law_table``; kept as (P, 6) with the compliance); gravity (3,) m/s^2 in the plate
+    frame; half_sizes (a/2, b/2) m; settle_energy (n,) J (0 = never); rtol; atol_x (m), atol_v
+    (m/s) (default rtol x 1 mm, rtol x 1 m/s, as the reference); max_steps per ``advance`` call;
+    nodes_per_step: interior force rows per step. Modal plate (optional, all m modes): omega
+    (m,) rad/s, zeta (m,), q, qd (m,) initial modal state (m sqrt(kg), m sqrt(kg)/s; default 0),
+    phi (P, m) mode shapes at each pair's contact point in 1/sqrt(kg) (rows of ball-ball pairs
+    ignored; ``set_phi`` changes a row for a new contact), f_dead (m,) constant modal forces in
+    N/sqrt(kg) (balls resting quasi-statically elsewhere); atol_q, atol_qd (default atol_x / s,
+    atol_v / s with s = max |phi| at construction, so that the deflection under a ball is held
+    to about atol_x; pass them when phi is only set later); compliance (P,) m/N: the residual
     compliance of each plate pair (default 0; entries of ball-ball pairs ignored).
     ``q``, ``qd``: views of the modal state (in/out). Per-pair state (in/out): touching, ramp,
     clamped, peak (N), t_peak (s), pen (m, max penetration). ``alive`` (n,): balls still
