@@ -316,7 +316,11 @@ class ActiveSet:
 def _with_compliance(laws, pj, compliance) -> np.ndarray:
     """(P, 6) law table: a (P, 5) ``law_table`` and the residual compliance of each plate
     pair (m/N; 0 for ball-ball pairs and when ``compliance`` is None)."""
-    laws = np.asarray(laws, dtype=float).reshape(len(pj), -1)[:, :5]
+    laws = np.asarray(laws, dtype=float)
+    laws = laws if laws.ndim == 2 else laws.reshape(-1, 5)
+    if laws.shape[0] != len(pj):
+        raise InputError("laws", f"one law per pair: got {len(laws)} laws for {len(pj)} pairs")
+    laws = laws[:, :5]
     cres = np.zeros(len(pj)) if compliance is None else np.asarray(compliance, dtype=float)
     if cres.shape != (len(pj),) or not np.all(np.isfinite(cres)) or np.any(cres < 0.0):
         raise InputError("compliance", f"must be {len(pj)} finite values >= 0 m/N (one per pair)")
