@@ -75,7 +75,7 @@ def fast(scene, basis, law, refresh=None):
     stream.SHAPE_TRAVEL, active_members.SHAPE_REUSE = travel, reuse
     try:
         balls, incline = scene
-        plate = StreamPlate(basis, np.full(basis.n_modes, ZETA))
+        plate = StreamPlate(basis, np.full(basis.n_modes, ZETA), residual_flexibility=False)
         t = time.perf_counter()
         run = stream.solve_stream(_particles(balls), incline, DURATION, rtol=1e-12,
                                   rest_speed=0.0, progress=False, plate=plate, **law)  # fmt: skip

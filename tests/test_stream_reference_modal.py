@@ -106,7 +106,7 @@ def _fast(scene, basis, law, travel=None, monkeypatch=None):
         monkeypatch.setattr(stream, "SHAPE_TRAVEL", travel)
         monkeypatch.setattr(active_members, "SHAPE_REUSE", travel)
     balls, incline = scene
-    plate = StreamPlate(basis, np.full(basis.n_modes, ZETA))
+    plate = StreamPlate(basis, np.full(basis.n_modes, ZETA), residual_flexibility=False)
     run = stream.solve_stream(_particles(balls), incline, SCENE_DURATION, rtol=1e-12,
                               rest_speed=0.0, progress=False, plate=plate, **law)  # fmt: skip
     assert run.stats["late_starts"] == 0
