@@ -22,17 +22,18 @@ from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.hertz import hertz_contact_duration
 from tailbeam.modal import ModalBasis
 from tailbeam.progress import task
+from tailbeam.solvers.records import EventKind
 
 DEFAULT_DAMPING_RATIO = 0.01  # of every mode; README "Defaults" (welded steel, light joints)
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid solver's value, so both models stop alike
 DEFAULT_STEPS_PER_CONTACT = 200  # steps per Hertz contact duration: ~1e-5 relative error
 _EVENT_NAMES = {
-    K.EV_START: "contact_start",
-    K.EV_END: "contact_end",
-    K.EV_DEEP: "full_damping",
-    K.EV_SHALLOW: "full_damping",
-    K.EV_CLAMP_ON: "clamp_on",
-    K.EV_CLAMP_OFF: "clamp_off",
+    K.EV_START: EventKind.CONTACT_START,
+    K.EV_END: EventKind.CONTACT_END,
+    K.EV_DEEP: EventKind.FULL_DAMPING,
+    K.EV_SHALLOW: EventKind.FULL_DAMPING,
+    K.EV_CLAMP_ON: EventKind.CLAMP_ON,
+    K.EV_CLAMP_OFF: EventKind.CLAMP_OFF,
 }
 
 
@@ -259,7 +260,7 @@ def simulate_coupled(
                         )
                     )
                     rest_time[balls[b].name] = t
-                    events.append((t, balls[b].name, "rest"))
+                    events.append((t, balls[b].name, EventKind.REST))
                     nbuf = _append_node(t, z, vz, F, cur, (bt, bz, bvz, bF, bd), nbuf, seg_phase)
             continue
         kind, b = int(evout[0]), int(evout[1])
@@ -304,7 +305,7 @@ def simulate_coupled(
             if at_rest:
                 _rest(b, t, balls, laws, mode, z, vz, F, cur, gravity, radius, phi, q)
                 rest_time[name] = t
-                events.append((t, name, "rest"))
+                events.append((t, name, EventKind.REST))
                 nbuf = _append_node(t, z, vz, F, cur, (bt, bz, bvz, bF, bd), nbuf, seg_phase)
             else:
                 h[b] = nominal_step(b, v_out)

@@ -12,8 +12,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tailbeam.errors import InputError, require_positive
+from tailbeam.solvers.records import EventKind
 
-EVENT_KINDS = ("contact_start", "full_damping", "clamp_on", "clamp_off", "contact_end", "rest")
+EVENT_KINDS = (EventKind.CONTACT_START, EventKind.FULL_DAMPING, EventKind.CLAMP_ON,
+               EventKind.CLAMP_OFF, EventKind.CONTACT_END, EventKind.REST)  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -18,9 +18,9 @@ truncated modes.
     rate = -(v_i - v_j) . n  (> 0 approaching); force F n on i, -F n on j (frictionless).
 
 ``law`` (P, 5) columns: stiffness k (N/m^e), exponent e, damping c (N s/m), penetration d (m),
-clamp (0/1), built by ``contact_law.ball_ball_law`` / ``ball_plate_law``. ``region_force``
-and ``clamp_indicator`` are the numba twins of ``contact_law.impact_force_in_region`` and
-``contact_law.clamp_indicator`` (tests/test_contact_law_regions.py checks them).
+clamp (0/1), built by ``contact_law.ball_ball_law`` / ``ball_plate_law``. The law itself
+(``region_force``, ``clamp_indicator``, ``elastic_energy``) is ``tailbeam.physics.impact``'s,
+the one definition every solver uses.
 
 Watched functions ("rows"), as in ``stream_reference._Reference.rows``: value g = sign x f +
 band, its event where g becomes negative:
@@ -36,58 +36,17 @@ grazing touch does not start and end contacts over and over at round-off level.
 
 import math
 
+from tailbeam.physics.impact import (
+    clamp_indicator,
+    elastic_energy,
+    region_force,
+)
 from tailbeam.solvers.jit import helper_njit
 
 L_K, L_E, L_C, L_D, L_CLAMP = range(5)
 R_CONTACT, R_FULL, R_CLAMP, R_EDGE = range(4)
 CLAMP_BAND = 1e-10
 EDGE_BAND = 1e-13
-
-
-@helper_njit
-def _pow(x, e):
-    """x^e for x >= 0; the Hertz exponent 3/2 as x sqrt(x)."""
-    if e == 1.5:
-        return x * math.sqrt(x)
-    return x**e
-
-
-@helper_njit
-def damping_in_region(delta, c, d, ramp):
-    """c STEP(delta, 0, 0, d, c) extended past [0, d] (ramp) or c (full damping), N s/m."""
-    if not ramp:
-        return c
-    s = delta / d
-    return c * s * s * (3.0 - 2.0 * s)
-
-
-@helper_njit
-def region_force(delta, rate, k, e, c, d, ramp, clamped):
-    """Force in N of one region's smooth formula (twin of impact_force_in_region)."""
-    if clamped:
-        return 0.0
-    pos = delta if delta > 0.0 else 0.0
-    return k * _pow(pos, e) + damping_in_region(pos, c, d, ramp) * rate
-
-
-@helper_njit
-def clamp_indicator(delta, rate, k, e, c, d, ramp):
-    """Raw force / (k delta^e) (twin of contact_law.clamp_indicator)."""
-    if delta > 0.0:
-        return 1.0 + damping_in_region(delta, c, d, ramp) * rate / (k * _pow(delta, e))
-    if ramp and e < 2.0:
-        return 1.0
-    if ramp and e == 2.0:
-        return 1.0 + 3.0 * c * rate / (k * d * d)
-    return -1.0 if rate < 0.0 else 1.0
-
-
-@helper_njit
-def elastic_energy(delta, k, e):
-    """k delta^(e+1) / (e+1) in J for delta > 0, else 0."""
-    if delta <= 0.0:
-        return 0.0
-    return k * _pow(delta, e) * delta / (e + 1.0)
 
 
 @helper_njit
