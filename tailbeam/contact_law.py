@@ -126,7 +126,8 @@ def _step(x, x0, h0, x1, h1):
 
 
 @vectorize(cache=True)
-def _force(delta, rate, k, e, c, d, clamp):
+def impact_force_array(delta, rate, k, e, c, d, clamp):
+    """``impact_force_scalar`` as a ufunc: every argument may be an array (one per pair)."""
     return impact.force(delta, rate, k, e, c, d, clamp)
 
 
@@ -153,7 +154,7 @@ def step(x, x0: float, h0: float, x1: float, h1: float):
 def impact_force(delta, delta_dot, law: ImpactLaw):
     """IMPACT force in N (arrays) of penetrations ``delta`` (m) and rates ``delta_dot`` (m/s)
     under ``law``."""
-    return _force(_floats(delta), _floats(delta_dot), *_parameters(law), law.clamp)
+    return impact_force_array(_floats(delta), _floats(delta_dot), *_parameters(law), law.clamp)
 
 
 def damping_in_region(delta, law: ImpactLaw, ramp):

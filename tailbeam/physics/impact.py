@@ -87,9 +87,17 @@ def force(delta, rate, k, e, c, d, clamp):
 
 
 @njit(cache=True)
+def elastic_stiffness(delta, k, e):
+    """d(k delta^e)/d(delta) = k e delta^(e-1) in N/m for delta > 0, else 0."""
+    if delta <= 0.0:
+        return 0.0
+    return k * e * power(delta, e) / delta
+
+
+@njit(cache=True)
 def region_force_slope(delta, rate, k, e, c, d, ramp):
     """dF/d(delta) in N/m of one region's formula at delta > 0 (unclamped)."""
-    return k * e * power(delta, e) / delta + region_damping_slope(delta, c, d, ramp) * rate
+    return elastic_stiffness(delta, k, e) + region_damping_slope(delta, c, d, ramp) * rate
 
 
 @njit(cache=True)

@@ -41,6 +41,8 @@ from tailbeam.physics.impact import (
     elastic_energy,
     region_force,
 )
+from tailbeam.physics.impact import power as _pow  # noqa: F401  (the names callers use)
+from tailbeam.physics.impact import region_damping as damping_in_region  # noqa: F401
 from tailbeam.solvers.jit import helper_njit
 
 L_K, L_E, L_C, L_D, L_CLAMP = range(5)
