@@ -1,7 +1,7 @@
 """Benchmark of `tailbeam sweep`: throughput on 1 and 2 Dask workers beside a plain loop,
 the share of dataset writing, and worker memory.
 
-    python benchmarks/bench_sweep.py [--out DIR] [--quick] [--cases N]
+    python benchmarks/bench_sweep.py [--out DIR] [--quick] [--cases N] [--set KEY=VALUE ...]
 
 The sweep: N single impacts (default 200; half coal, half sandstone; radius log-uniform
 10-100 mm, 1-5 m/s, anywhere over |x|, |y| <= 0.25 m) on the SSSS modal plate (modes to 5 kHz,
@@ -15,7 +15,9 @@ client process (the client, the in-process scheduler and the nannies) per case, 
 worker's peak resident memory. The client imports its writing libraries (xarray, zarr,
 pyarrow) before the clocks start, as it does the workers: a one-off ~0.3 s per process that
 would otherwise be charged to whichever run writes first. Writes DIR/bench_sweep.csv and
-DIR/table.md. Timings on a shared machine are noisy: run it 2-3 times.
+DIR/table.md. Timings on a shared machine are noisy: run it 2-3 times. ``--set`` changes a Dask
+setting for both clusters (e.g. ``--set distributed.scheduler.worker-saturation=inf``), to
+measure a choice of ``tailbeam.study.sweep.SCHEDULER_CONFIG`` against the shipped one.
 """
 
 import argparse
@@ -201,6 +203,12 @@ if __name__ == "__main__":
     parser.add_argument("--out", default="out/benchmarks/bench_sweep")
     parser.add_argument("--quick", action="store_true", help="20 cases")
     parser.add_argument("--cases", type=int, default=None)
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     args = parser.parse_args()
     np.seterr(all="ignore")
-    main(args.out, quick=args.quick, n_cases=args.cases)
+    import dask
+    import yaml
+
+    changes = {k: yaml.safe_load(v) for k, v in (item.split("=", 1) for item in args.set)}
+    with dask.config.set(changes):
+        main(args.out, quick=args.quick, n_cases=args.cases)

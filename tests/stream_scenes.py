@@ -5,6 +5,8 @@ import math
 from tailbeam import COAL, SANDSTONE, Ball, ball_plate_law
 from tailbeam.materials import CARBON_STEEL
 
+MIN_APPROACH = 0.1  # m/s: an impact approaches faster than this
+
 
 def static_penetration_on(material, radius, incline) -> float:
     """Penetration in m at which a ball of ``material``, ``radius`` rests on ``incline``
@@ -57,3 +59,39 @@ def leave_scene(incline):
         Ball("r3", COAL, 0.025, (-0.25, -0.1, 0.06), (-1.0, -0.3, 0.0)),
         Ball("r4", SANDSTONE, 0.015, (0.16, 0.0, z1 + 0.06), (0.3, 0.0, -0.3)),
     ]
+
+
+def _firsts(contacts) -> dict:
+    """Each ball's first contact that is an impact (ends separated, approach > MIN_APPROACH:
+    the chatter of a ball settling on the plate or on another is not an impact)."""
+    out = {}
+    for c in sorted(contacts, key=lambda c: (c.t_start, c.ball, c.partner)):
+        if c.ball not in out and c.end == "separated" and c.approach_in > MIN_APPROACH:
+            out[c.ball] = c
+    return out
+
+
+def first_impact_difference(contacts, truth):
+    """(common prefix length, truth's contacts, first impacts compared, worst relative
+    difference over them). A ball's first impact is compared when it is, in both runs, the
+    same impact (same partner, start within 1 % of its duration)."""
+
+    def order(cs):
+        return sorted(cs, key=lambda c: (c.t_start, c.ball, c.partner))
+
+    a, b = order(contacts), order(truth)
+    n = 0
+    while n < min(len(a), len(b)) and (a[n].ball, a[n].partner) == (b[n].ball, b[n].partner):
+        n += 1
+    worst, compared = 0.0, 0
+    got = _firsts(contacts)
+    for ball, y in _firsts(truth).items():
+        x = got.get(ball)
+        dur_y = y.t_end - y.t_start
+        if x is None or x.partner != y.partner or abs(x.t_start - y.t_start) > 0.01 * dur_y:
+            continue
+        compared += 1
+        worst = max(worst, abs((x.t_end - x.t_start) - dur_y) / dur_y)
+        worst = max(worst, abs(x.peak_force - y.peak_force) / y.peak_force)
+        worst = max(worst, abs(x.approach_out - y.approach_out) / y.approach_in)
+    return n, len(b), compared, worst

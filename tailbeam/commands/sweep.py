@@ -31,8 +31,8 @@ def run(args) -> int:
     from tailbeam.study.sweep import run_sweep
 
     spec = load_sweep(args.sweep)
-    expand(spec)  # every case's scene validated before a worker starts
-    s = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler)
+    cases = expand(spec)  # every case's scene validated before a worker starts
+    s = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, cases=cases)
     ran = s["ok"] + s["failed"]
     print(
         f"{args.sweep}: {s['cases']} cases, {s['skipped']} already done, {ran} run "

@@ -326,50 +326,20 @@ def compute_modes(
             f"no mode lies below {fmax_hz!r} Hz for boundary "
             f"{boundary!r} (the plate's lowest elastic mode is higher)",
         )
-    # a reproducible sign: the largest DOF of each vector is positive
-    big = np.argmax(np.abs(phi), axis=0)
-    signs = np.sign(phi[big, np.arange(phi.shape[1])])
-    phi = phi * np.where(signs == 0, 1.0, signs)
-    info = {
-        "theory": res.theory,
-        "reason": res.reason,
-        "element": model.element,
-        "boundary": boundary,
-        "edges": describe(boundary),
-        "mesh": str(mesh)
-        if mesh is not None and not isinstance(mesh, MeshTri)
-        else ("user MeshTri" if mesh is not None else f"structured, divisions {res.divisions}"),
-        "divisions": res.divisions,
-        "n_triangles": int(mesh_obj.t.shape[1]),
-        "n_dofs": model.n_dofs,
-        "fmax_hz": fmax_hz,
-        "count": count,
-        "accuracy": accuracy,
-        "top_frequency_hz": res.top_frequency_hz,
-        "predicted_discretisation_error": res.predicted_error,
-        "kirchhoff_model_error_at_top": res.kirchhoff_model_error,
-        "rigid_body_modes_excluded": rigid_body_mode_count(boundary),
-        "assembly_s": t1 - t0,
-        "eigensolve_s": t2 - t1,
-        "blas_threads": threads,
-        "cost_estimate": cost.as_dict(),
-        "cache": "off" if not use_cache else "miss",
-        "cache_file": str(path) if use_cache else None,
-    }
+    phi = _signed(phi)
+    info = _describe(plate, boundary, res, model, mesh, mesh_obj, fmax_hz, count, accuracy)
+    info.update(
+        {
+            "assembly_s": t1 - t0,
+            "eigensolve_s": t2 - t1,
+            "blas_threads": threads,
+            "cost_estimate": cost.as_dict(),
+            "cache": "off" if not use_cache else "miss",
+            "cache_file": str(path) if use_cache else None,
+        }
+    )
     if use_cache:
-        try:
-            modal_cache.save(
-                path,
-                key,
-                frequencies_hz=freqs,
-                vectors=phi,
-                free_dofs=model.free_dofs,
-                n_full=model.n_full,
-                mesh=mesh_obj,
-                info=info,
-            )
-        except OSError as err:  # an unwritable cache must not lose a finished computation
-            info.update(cache=f"not written: {err}", cache_file=None)
+        _store(path, key, freqs, phi, model, mesh_obj, info)
     return _make_basis(
         plate,
         boundary,
@@ -385,3 +355,47 @@ def compute_modes(
         shared_key=key if use_cache else None,
         probe_basis=model.deflection_basis,
     )
+
+
+def _signed(phi: np.ndarray) -> np.ndarray:
+    """Mode vectors (columns) with a reproducible sign: the largest DOF of each is positive."""
+    big = np.argmax(np.abs(phi), axis=0)
+    signs = np.sign(phi[big, np.arange(phi.shape[1])])
+    return phi * np.where(signs == 0, 1.0, signs)
+
+
+def _describe(plate, boundary, res, model, mesh, mesh_obj, fmax_hz, count, accuracy) -> dict:
+    """The basis' info: what was chosen (theory, mesh, band) and why."""
+    if mesh is None:
+        mesh_text = f"structured, divisions {res.divisions}"
+    else:
+        mesh_text = "user MeshTri" if isinstance(mesh, MeshTri) else str(mesh)
+    return {
+        "theory": res.theory,
+        "reason": res.reason,
+        "element": model.element,
+        "boundary": boundary,
+        "edges": describe(boundary),
+        "mesh": mesh_text,
+        "divisions": res.divisions,
+        "n_triangles": int(mesh_obj.t.shape[1]),
+        "n_dofs": model.n_dofs,
+        "fmax_hz": fmax_hz,
+        "count": count,
+        "accuracy": accuracy,
+        "top_frequency_hz": res.top_frequency_hz,
+        "predicted_discretisation_error": res.predicted_error,
+        "kirchhoff_model_error_at_top": res.kirchhoff_model_error,
+        "rigid_body_modes_excluded": rigid_body_mode_count(boundary),
+    }
+
+
+def _store(path, key, freqs, phi, model, mesh_obj, info) -> None:
+    """Save the basis in the cache; an unwritable cache is noted in ``info``, not raised (a
+    finished computation must not be lost)."""
+    try:
+        modal_cache.save(path, key, frequencies_hz=freqs, vectors=phi,
+                         free_dofs=model.free_dofs, n_full=model.n_full, mesh=mesh_obj,
+                         info=info)  # fmt: skip
+    except OSError as err:
+        info.update(cache=f"not written: {err}", cache_file=None)

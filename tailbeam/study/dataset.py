@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam import __version__
+from tailbeam.scene_file import loads_scene
 
 LABEL_COLUMNS = (
     "label",
@@ -150,11 +151,11 @@ class DatasetStore:
     # -- writing ----------------------------------------------------------------------------------
 
     def record(self, batch: list) -> None:
-        """Write a batch of (Case, result dict, Scene) of finished or failed cases."""
+        """Write a batch of (Case, result dict) of finished or failed cases."""
         self.dir.mkdir(parents=True, exist_ok=True)
         rows, ok = [], []
-        ids = self.case_ids([case.hash for case, _r, _s in batch])
-        for (case, result, scene), cid in zip(batch, ids, strict=True):
+        ids = self.case_ids([case.hash for case, _r in batch])
+        for (case, result), cid in zip(batch, ids, strict=True):
             row = {
                 "case": cid,
                 "case_hash": case.hash,
@@ -172,7 +173,7 @@ class DatasetStore:
             }
             rows.append(row)
             if result["status"] == "ok":
-                ok.append((row, case, result, scene))
+                ok.append((row, case, result))
         if ok:
             self._write_impacts(ok)
             self._append_zarr(ok)
@@ -184,7 +185,7 @@ class DatasetStore:
 
         rows = [
             {"case": row["case"], "case_hash": case.hash, **impact}
-            for row, case, result, _scene in ok
+            for row, case, result in ok
             for impact in result["impacts"]
         ]
         frames = [f for f in (self.impacts, pd.DataFrame(rows)) if f is not None and len(f)]
@@ -200,7 +201,7 @@ class DatasetStore:
 
         ds = self._batch_dataset(ok)
         existing = self.zarr_path.exists()
-        scenes = {case.hash: case.toml for _r, case, _res, _s in ok}
+        scenes = {case.hash: case.toml for _r, case, _res in ok}
         if existing:
             scenes = {**zarr.open_group(self.zarr_path, mode="r").attrs["case_scenes"], **scenes}
         ds.attrs["case_scenes"] = scenes
@@ -226,10 +227,10 @@ class DatasetStore:
     def _batch_dataset(self, ok: list):
         import xarray as xr
 
-        first_scene = ok[0][3]
+        first_scene = loads_scene(ok[0][1].toml)  # what every case shares (design.expand)
         names = [s.name for s in first_scene.sensors]
         fs = first_scene.sensors[0].sample_rate
-        acc = np.stack([np.stack([res["signals"][n] for n in names]) for _r, _c, res, _s in ok])
+        acc = np.stack([np.stack([res["signals"][n] for n in names]) for _r, _c, res in ok])
         n_time = acc.shape[-1]
         coords = {
             "case": ("case", np.array([r["case"] for r, *_ in ok], dtype=np.int64)),
@@ -241,7 +242,7 @@ class DatasetStore:
             values = np.array([r[col] for r, *_ in ok])
             coords[col] = ("case", values.astype(object) if values.dtype.kind == "U" else values)
         for axis, unit in ((0, "sensor_x"), (1, "sensor_y")):
-            pos = [[s.position[axis] for s in sc.sensors] for _r, _c, _res, sc in ok]
+            pos = [[xy[axis] for xy in case.sensor_xy] for _r, case, _res in ok]
             coords[unit] = (("case", "sensor"), np.array(pos), {"units": "m"})
         acc_attrs = {"units": "m/s^2", "long_name": "sensor acceleration normal to the plate"}
         return xr.Dataset(

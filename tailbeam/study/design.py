@@ -42,6 +42,7 @@ import numpy as np
 
 from tailbeam.errors import InputError, require_positive
 from tailbeam.scene_file import _check_keys, dumps_scene, parse_scene
+from tailbeam.study.case import basis_signature
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -85,7 +86,9 @@ class SweepSpec:
 
 @dataclass(frozen=True)
 class Case:
-    """One scene of the sweep: swept values, repeat, seed, scene TOML and its hash, labels."""
+    """One scene of the sweep: swept values, repeat, seed, scene TOML and its hash, labels,
+    its modal basis key (``case.basis_signature``) and its sensors' (x, y) positions (m): what
+    the client needs of the scene, so it never parses the TOML again."""
 
     params: dict
     repeat: int
@@ -93,6 +96,8 @@ class Case:
     toml: str
     hash: str
     labels: dict
+    basis: str = ""
+    sensor_xy: tuple = ()
 
 
 def _field(key: str) -> str:
@@ -395,7 +400,9 @@ def make_case(spec: SweepSpec, params: dict, repeat: int, number: int):
         raise InputError(f"case {number} ({shown}): {err.field}", err.rule) from None
     toml = dumps_scene(scene) + f"# case seed = {seed}\n"
     digest = hashlib.sha256(toml.encode()).hexdigest()
-    return Case(params, repeat, seed, toml, digest, case_labels(scene, spec.coal)), scene
+    labels = case_labels(scene, spec.coal)
+    xy = tuple((float(s.position[0]), float(s.position[1])) for s in scene.sensors)
+    return Case(params, repeat, seed, toml, digest, labels, basis_signature(scene), xy), scene
 
 
 def expand(spec: SweepSpec) -> list:

@@ -21,7 +21,7 @@ import uuid
 from tailbeam.errors import InputError
 from tailbeam.progress import note, task
 from tailbeam.scene_file import loads_scene
-from tailbeam.study.case import basis_signature, run_case, warm_basis
+from tailbeam.study.case import run_case, warm_basis
 from tailbeam.study.dataset import DatasetStore
 from tailbeam.study.design import expand
 
@@ -43,6 +43,21 @@ WORKER_CONFIG = {
         "OPENBLAS_NUM_THREADS": 1,
     },
 }
+# the local scheduler and nannies, which share the cores with the workers:
+# - the system monitor (CPU, memory, disk and network counters for the dashboard, which a sweep
+#   does not start) every 2 s instead of every 0.5 s, without disk;
+# - the event-loop health tick (it only warns when a loop was blocked for seconds) every 0.2 s
+#   instead of 20 ms, and the nannies' check of their worker's memory every 0.5 s instead of
+#   0.1 s (a case takes ~0.4 GB of a limit of GBs). Together these periodic callbacks took
+#   ~10 % of the client process's event-loop CPU (yappi), which competes with the workers.
+# Dask's queuing stays on (worker-saturation 1.1): sending every case at once
+# (worker-saturation inf) made 1 worker faster and 2 workers slower (docs/datasets.md).
+SCHEDULER_CONFIG = {
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.admin.system-monitor.disk": False,
+    "distributed.admin.tick.interval": "200ms",
+    "distributed.worker.memory.monitor-interval": "500ms",
+}
 
 
 def default_workers() -> int:
@@ -55,14 +70,16 @@ def default_workers() -> int:
 
 def local_cluster(n_workers: int):
     """A dask.distributed LocalCluster of ``n_workers`` single-threaded processes on
-    127.0.0.1, without dashboard, with WORKER_CONFIG; the scheduler's HTTP routes take a free
-    port (not 8787, so sweeps and other Dask users on one machine do not collide)."""
+    127.0.0.1, without dashboard, with WORKER_CONFIG and SCHEDULER_CONFIG; the scheduler's
+    HTTP routes take a free port (not 8787, so sweeps and other Dask users on one machine do
+    not collide)."""
     import logging
 
     import dask
     from dask.distributed import LocalCluster
 
-    with dask.config.set(WORKER_CONFIG):  # the nannies pass it on to their workers
+    # the scheduler is built here, in this process; the nannies pass the config to the workers
+    with dask.config.set({**SCHEDULER_CONFIG, **WORKER_CONFIG}):
         return LocalCluster(
             n_workers=n_workers,
             threads_per_worker=1,
@@ -101,9 +118,10 @@ def close_client(client) -> None:
         cluster.close()
 
 
-def plan(spec, out_dir):
-    """(all cases, cases still to run, store): the finished cases of out_dir are skipped."""
-    cases = expand(spec)
+def plan(spec, out_dir, cases=None):
+    """(all cases, cases still to run, store): the finished cases of out_dir are skipped.
+    ``cases``: expand(spec) if already computed."""
+    cases = expand(spec) if cases is None else cases
     store = DatasetStore(out_dir, spec.text)
     done = store.done()
     todo, seen = [], set(done)
@@ -116,23 +134,20 @@ def plan(spec, out_dir):
 
 def _submit(client, todo: list, coal: tuple) -> dict:
     """Submit the basis warm-up tasks and the case tasks (one task per case, one
-    ``client.map`` call per basis); future key -> (case, scene)."""
-    groups = {}  # basis signature -> [(case, scene)]
+    ``client.map`` call per basis); future -> case."""
+    groups = {}  # basis signature -> [case]
     for c in todo:
-        scene = loads_scene(c.toml)
-        groups.setdefault(basis_signature(scene), []).append((c, scene))
+        groups.setdefault(c.basis, []).append(c)
     futures = {}
     for members in groups.values():
-        warm = client.submit(
-            warm_basis, members[0][0].toml, key=f"tailbeam-basis-{uuid.uuid4().hex}"
-        )
+        warm = client.submit(warm_basis, members[0].toml, key=f"tailbeam-basis-{uuid.uuid4().hex}")
         n = len(members)
-        keys = [f"tailbeam-case-{c.hash[:16]}-{uuid.uuid4().hex[:8]}" for c, _s in members]
-        tomls = [c.toml for c, _s in members]
-        for fut, member in zip(
+        keys = [f"tailbeam-case-{c.hash[:16]}-{uuid.uuid4().hex[:8]}" for c in members]
+        tomls = [c.toml for c in members]
+        for fut, case in zip(
             client.map(run_case, tomls, [coal] * n, [warm] * n, key=keys), members, strict=True
         ):
-            futures[fut] = member
+            futures[fut] = case
     return futures
 
 
@@ -159,14 +174,14 @@ def _failed_task(fut) -> dict:
     }
 
 
-def run_sweep(spec, out_dir, *, workers=None, scheduler=None, client=None) -> dict:
+def run_sweep(spec, out_dir, *, workers=None, scheduler=None, client=None, cases=None) -> dict:
     """Run the cases of ``spec`` not yet finished in ``out_dir``; returns counts and times.
 
     ``client``: an existing dask.distributed Client to use (then workers/scheduler are
-    ignored and the client is left open)."""
+    ignored and the client is left open). ``cases``: ``expand(spec)`` if the caller has it."""
     from dask.distributed import as_completed
 
-    cases, todo, store = plan(spec, out_dir)
+    cases, todo, store = plan(spec, out_dir, cases)
     summary = {"cases": len(cases), "skipped": len(cases) - len(todo), "ok": 0, "failed": 0}
     if not todo:
         note(f"sweep: all {len(cases)} cases already done in {out_dir}")
@@ -188,17 +203,18 @@ def run_sweep(spec, out_dir, *, workers=None, scheduler=None, client=None) -> di
         with task(f"sweep of {len(todo)} cases", total=len(todo), unit="cases") as bar:
             for done in as_completed(list(futures)).batches():
                 for fut, result in zip(done, _results_of(client, done), strict=True):
-                    case, scene = futures.pop(fut)
+                    case = futures.pop(fut)
                     summary[result["status"]] += 1
                     if result["status"] != "ok":
                         bar.set_postfix(f"{summary['failed']} failed")
                         note(f"case {case.hash[:12]} failed ({summary['failed']} so far): "
                              f"{result['error']}")  # fmt: skip
-                    batch.add(case, result, scene)
+                    batch.add(case, result)
                 bar.update(len(done))
                 if batch.full():
                     write_s += batch.flush(store)
-                time.sleep(GATHER_INTERVAL_S)  # let results accumulate: fewer, larger gathers
+                if futures:  # let results accumulate: fewer, larger gathers
+                    time.sleep(GATHER_INTERVAL_S)
             write_s += batch.flush(store)
     finally:
         if own:
@@ -214,8 +230,8 @@ class _Batch:
     def __init__(self):
         self.items, self.bytes, self.start = [], 0, time.monotonic()
 
-    def add(self, case, result, scene) -> None:
-        self.items.append((case, result, scene))
+    def add(self, case, result) -> None:
+        self.items.append((case, result))
         self.bytes += sum(a.nbytes for a in result["signals"].values())
 
     def full(self) -> bool:
