@@ -84,10 +84,10 @@ def _import_writers() -> None:
     import zarr  # noqa: F401
 
 
-def baseline(cases, coal) -> dict:
+def baseline(cases) -> dict:
     t0 = time.perf_counter()
     for c in cases:
-        run_case(c.toml, coal)
+        run_case(c.toml)
     wall = time.perf_counter() - t0
     return {"run": "plain loop (no Dask)", "workers": 1, "wall_s": wall, "cases": len(cases)}
 
@@ -98,7 +98,7 @@ def dask_run(spec, n_workers: int, out: Path) -> dict:
         # warm every worker: imports, numba cache, basis cache (not timed)
         first = expand(spec)[0]
         client.run(warm_basis, first.toml)
-        client.run(run_case, first.toml, spec.coal)
+        client.run(run_case, first.toml)
         t0, c0 = time.perf_counter(), time.process_time()
         summary = run_sweep(spec, out, client=client)
         wall, client_cpu = time.perf_counter() - t0, time.process_time() - c0
@@ -134,8 +134,8 @@ def main(out_dir="out/benchmarks/bench_sweep", quick: bool = False, n_cases: int
     cases = expand(spec)
     _import_writers()
     warm_basis(cases[0].toml)
-    run_case(cases[0].toml, spec.coal)  # compile/load numba here too
-    rows = [baseline(cases, spec.coal)]
+    run_case(cases[0].toml)  # compile/load numba here too
+    rows = [baseline(cases)]
     for w in (1, 2):
         target = out_dir / f"dataset_{w}w"
         if target.exists():

@@ -18,6 +18,7 @@ from tailbeam.contact_law import (  # noqa: E402
 )
 from tailbeam.errors import InputError, WorkLimitError  # noqa: E402
 from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE, Material, get_material  # noqa: E402
+from tailbeam.result import Result  # noqa: E402
 from tailbeam.simulation import simulate  # noqa: E402
 
 __all__ = [
@@ -36,6 +37,7 @@ __all__ = [
     "CARBON_STEEL",
     "get_material",
     "simulate",
+    "Result",
 ]
 
 __version__ = "0.2.0"

@@ -1,4 +1,5 @@
-"""Writing simulation results: impacts.csv/json, timeseries.csv, sensors.csv, claims tables.
+"""Writing simulation results: impacts.csv/json, particles.csv, timeseries.csv, sensors.csv,
+claims tables.
 
 Plain CSV (comma separated, one header line, SI units, floats written with ``repr`` so they
 read back bit for bit) and JSON (NaN written as null). No physics here.
@@ -11,8 +12,13 @@ from pathlib import Path
 
 import numpy as np
 
-# Column order of impacts.csv (the contract's first ten columns, then the rest) and units.
-from tailbeam.solvers.stream_result import IMPACT_COLUMNS, IMPACT_UNITS  # noqa: F401
+# Column order of impacts.csv (the contract's first twelve columns, then the rest) and units.
+from tailbeam.result import (  # noqa: F401 - IMPACT_COLUMNS: imported from here by callers
+    IMPACT_COLUMNS,
+    IMPACT_TABLE_UNITS,
+    IMPACT_UNITS,
+    PARTICLE_UNITS,
+)
 
 
 def _cell(value) -> str:
@@ -35,7 +41,8 @@ def write_csv(path, header, rows) -> Path:
 
 
 def write_impacts_csv(path, impacts) -> Path:
-    """One row per contact, columns IMPACT_COLUMNS (units in the manifest)."""
+    """The twelve historical columns (IMPACT_COLUMNS) of single-ball ``Impact`` records, one
+    row per contact (units in the manifest); the outputs write ``write_result_tables``."""
     from tailbeam.output import describe
 
     write_csv(path, IMPACT_COLUMNS, ([getattr(i, c) for c in IMPACT_COLUMNS] for i in impacts))
@@ -51,20 +58,15 @@ def write_table_csv(path, table: dict, units: dict) -> Path:
     return describe(path, units={c: u for c, u in units.items() if c in table})
 
 
-def stream_summary(result, scene_echo: dict | None = None) -> dict:
-    """impacts.json of a stream scene: scene echo, units, impacts (rows of impacts.csv),
-    leave events, solver statistics and choices."""
-    from tailbeam.solvers.stream_result import STREAM_IMPACT_UNITS
-
-    table = result.impacts_table()
-    out = {} if scene_echo is None else {"scene": scene_echo}
-    out["units"] = STREAM_IMPACT_UNITS
-    rows = zip(*table.values(), strict=True)
-    out["impacts"] = [dict(zip(table, row, strict=True)) for row in rows]
-    out["leaves"] = [{"ball": e.ball, "time": e.time, "edge": e.edge} for e in result.leaves]
-    out["solver"] = {**result.stats, "status": result.status, "message": result.message}
-    out["automatic_choices"] = dict(result.info)
-    return out
+def write_result_tables(out_dir, result, scene_echo: dict | None = None) -> list:
+    """impacts.csv (every column of ``result.impacts_table()``), particles.csv and
+    impacts.json of any ``tailbeam.result.Result`` into the folder ``out_dir``."""
+    out_dir = Path(out_dir)
+    return [
+        write_table_csv(out_dir / "impacts.csv", result.impacts_table(), IMPACT_TABLE_UNITS),
+        write_table_csv(out_dir / "particles.csv", result.particles_table(), PARTICLE_UNITS),
+        write_json(out_dir / "impacts.json", result_summary(result, scene_echo)),
+    ]
 
 
 def _jsonable(value):
@@ -90,20 +92,25 @@ def write_json(path, data) -> Path:
 
 
 def result_summary(result, scene_echo: dict | None = None) -> dict:
-    """The content of impacts.json: scene echo, impacts, rest times, solver statistics."""
-    out = {}
-    if scene_echo is not None:
-        out["scene"] = scene_echo
-    out["units"] = IMPACT_UNITS
-    out["impacts"] = [{c: getattr(i, c) for c in IMPACT_COLUMNS} for i in result.impacts]
-    out["rest_time"] = dict(result.rest_time)
-    out["solver"] = {
-        "nfev": getattr(result, "nfev", None),
-        "n_steps": getattr(result, "n_steps", None),
-        "status": getattr(result, "status", None),
-        "message": getattr(result, "message", ""),
-    }
+    """The content of impacts.json: scene echo, units, impacts (the rows of impacts.csv),
+    leave events, rest times (single-ball solvers), solver statistics and choices."""
+    table = result.impacts_table()
+    out = {} if scene_echo is None else {"scene": scene_echo}
+    out["units"] = IMPACT_TABLE_UNITS
+    rows = zip(*table.values(), strict=True)
+    out["impacts"] = [dict(zip(table, row, strict=True)) for row in rows]
+    out["leaves"] = [{"ball": e.ball, "time": e.time, "edge": e.edge} for e in result.leaves]
+    if hasattr(result, "rest_time"):
+        out["rest_time"] = dict(result.rest_time)
+    out["solver"] = {**result.stats, "status": result.status, "message": result.message}
+    out["automatic_choices"] = _choices(result.info)
     return out
+
+
+def _choices(info: dict) -> dict:
+    """What was chosen automatically, from a result's ``info`` (objects such as the rigid
+    result a one-way run keeps there are left out)."""
+    return {k: v for k, v in info.items() if not hasattr(v, "__dataclass_fields__")}
 
 
 def uniform_grid(duration: float, sample_rate: float) -> np.ndarray:

@@ -1,15 +1,16 @@
 """``tailbeam.simulate(scene, **how)``: the one library call that runs a scene.
 
 What to simulate (a ``tailbeam.scene.Scene``) is positional; how (rtol, max_steps,
-progress) is keyword-only. The scene chooses the solver:
+progress) is keyword-only. It returns one result type, ``tailbeam.result.Result``, whichever
+solver the scene chooses:
 
 - rigid plate, no streams, no inclination, no two balls that can touch (their horizontal
   paths never come within the sum of the radii): ``tailbeam.rigid.simulate_rigid``, exact
-  per ball (a ``RigidResult``);
-- modal plate: the coupled modal solver (``tailbeam.coupled.simulate_scene_modal``);
-  streams, inclination and ball-ball contact are refused there for now (InputError);
+  per ball (its ``Result`` is a ``RigidResult``);
+- modal plate with balls only: the coupled modal solver
+  (``tailbeam.coupled.simulate_scene_modal``, a ``CoupledResult``);
 - otherwise (streams, an inclined plate, balls that may touch): the stream solver of
-  ``tailbeam.solvers.engine`` (a ``StreamResult``).
+  ``tailbeam.solvers.engine`` (a ``StreamResult``), on the rigid or the modal plate.
 """
 
 import contextlib
@@ -37,7 +38,14 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
 
     Returns
     -------
-    RigidResult, the coupled solver's result, or StreamResult (tailbeam.solvers.stream_result).
+    tailbeam.Result
+        One interface for every solver: ``status``, ``message``, ``stats``, ``info``,
+        ``impacts_table()`` (impacts.csv as numpy columns), ``particles_table()``
+        (particles.csv), ``events_of(name, kind)``, ``impacts_of(name)``, ``leaves``,
+        ``sensor_outputs`` / ``sensor_signals``, ``plate_model``; ``sample(times)`` for the
+        single-ball solvers (``keeps_states``). The subclass (``RigidResult``,
+        ``CoupledResult``, ``StreamResult``) adds what is its solver's own (the modal replay
+        of ``CoupledResult``, ...).
     """
     from tailbeam.scene import Scene
 
@@ -52,9 +60,9 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
             if band:
                 _modal_sensors(scene, result, band, plate)
             return result
-        if scene.plate_model == "modal":
-            return _modal(scene, how)
-        return _rigid(scene, how)
+        result = _modal(scene, how) if scene.plate_model == "modal" else _rigid(scene, how)
+        result.labels = scene.labels  # the scene's coal / gangue labels of its balls
+        return result
 
 
 def _rigid(scene, how):

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tailbeam.result import IMPACT_TABLE_COLUMNS
 from tailbeam.results_io import IMPACT_COLUMNS
 
 ROOT = Path(__file__).parents[1]
@@ -42,8 +43,8 @@ def simulated(tmp_path_factory):
 
 def test_simulate_writes_impacts(simulated):
     header, rows = read_csv(simulated / "impacts.csv")
-    assert tuple(header[:10]) == IMPACT_COLUMNS[:10]
-    assert tuple(header) == IMPACT_COLUMNS
+    assert tuple(header[:12]) == IMPACT_COLUMNS  # the historical columns first, unchanged
+    assert tuple(header) == IMPACT_TABLE_COLUMNS
     assert {r[0] for r in rows} == {"coal", "sandstone"}
     data = json.loads((simulated / "impacts.json").read_text())  # strict JSON (no NaN)
     assert len(data["impacts"]) == len(rows)
@@ -164,7 +165,7 @@ def test_reproduce(tmp_path):
     assert proc.returncode == (0 if all(v == "PASS" for v in verdicts) else 1), proc.stderr
     assert len(rows) >= 19 and set(verdicts) <= {"PASS", "FAIL"}
     for key in ("velocity", "material", "energy"):
-        for name in ("impacts.csv", "impacts.json", "timeseries.csv"):
+        for name in ("impacts.csv", "particles.csv", "impacts.json", "timeseries.csv"):
             assert (out / key / name).stat().st_size > 0
     assert len(list(out.glob("fig*.png"))) == 9
     assert (out / "claims.md").read_text().count("\n") == len(rows) + 2

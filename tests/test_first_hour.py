@@ -214,7 +214,13 @@ def test_a_run_replaces_the_folder_whole(tmp_path, capsys):
     code, _, err = run_cli(["simulate", scene, "--out", out, "-q"], capsys)
     assert code == 0, err
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["impacts.csv", "impacts.json", "manifest.json", "timeseries.csv"]
+    assert names == [
+        "impacts.csv",
+        "impacts.json",
+        "manifest.json",
+        "particles.csv",
+        "timeseries.csv",
+    ]
     manifest = json.loads((out / "manifest.json").read_text())
     assert sorted(manifest["files"]) == [n for n in names if n != "manifest.json"]
     assert manifest["tailbeam_version"] == tailbeam.__version__

@@ -168,3 +168,30 @@ def test_example_sweep_file_expands_to_its_stated_cases():
         r = c.params["balls.rock.radius"]
         assert 0.01 <= r <= 0.1
         assert c.params["balls.rock.position[2]"] == pytest.approx(r + 0.0002, rel=1e-12)
+
+
+def test_labels_coal_labels_the_balls_in_the_scene():
+    """``labels.coal`` decides each ball's label in the case's scene (so impacts.csv's
+    ``label`` and the dataset's ``class`` agree with it); the default rule writes nothing,
+    so the case hashes of a default sweep do not change; an explicit ``label`` wins."""
+    from tailbeam.scene_file import loads_scene
+    from tailbeam.study.case import run_case
+
+    grid = {"balls.rock.material": ["coal", "sandstone"]}
+    default = expand(sweep(grid))
+    assert all("label" not in c.toml for c in default)
+    near = {**BASE, "balls": [{**BASE["balls"][0], "position": [0.0, 0.0, 0.021]}]}
+    spec = parse_sweep({"scene": near, "axes": grid, "labels": {"coal": ["sandstone"]}})
+    cases = expand(spec)  # sandstone counted as coal, each ball 1 mm above the plate
+    labels = [loads_scene(c.toml).labels for c in cases]
+    assert labels == [("gangue",), ("coal",)]
+    assert [c.labels["label"] for c in cases] == ["gangue", "coal"]
+    out = run_case(cases[1].toml)
+    assert out["status"] == "ok" and out["impacts"]
+    assert {(r["material"], r["label"], r["class"]) for r in out["impacts"]} == {
+        ("sandstone", "coal", "coal")
+    }
+    assert out["n_coal_impacts"] == len(out["impacts"]) and out["n_gangue_impacts"] == 0
+    base = {**BASE, "balls": [{**BASE["balls"][0], "label": "gangue"}]}
+    spec = parse_sweep({"scene": base, "axes": grid})
+    assert [loads_scene(c.toml).labels for c in expand(spec)] == [("gangue",), ("gangue",)]

@@ -50,9 +50,7 @@ def dataset(tmp_path_factory):
     )
     out = tmp_path_factory.mktemp("learn") / "out"
     store = DatasetStore(out)
-    from tailbeam.scene_file import loads_scene
-
-    store.record([(c, run_case(c.toml, spec.coal), loads_scene(c.toml)) for c in expand(spec)])
+    store.record([(c, run_case(c.toml)) for c in expand(spec)])  # (Case, result) pairs
     return out
 
 

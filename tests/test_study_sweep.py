@@ -153,7 +153,7 @@ def test_a_case_prints_nothing_and_restores_progress(capsys):
     from tailbeam.study.case import run_case
 
     assert not is_quiet()
-    out = run_case(BASE, ("coal",))
+    out = run_case(BASE)
     assert out["status"] == "ok", out["error"]
     assert capsys.readouterr().err == ""
     assert not is_quiet()

@@ -79,14 +79,10 @@ def run(args) -> int:
 
 
 def _write_scenarios(tmp, results) -> None:
-    """Per scenario: impacts.csv, impacts.json, timeseries.csv and the figures."""
+    """Per scenario: impacts.csv, particles.csv, impacts.json, timeseries.csv and the
+    figures."""
     from tailbeam.figures import scenario_figures
-    from tailbeam.results_io import (
-        result_summary,
-        write_impacts_csv,
-        write_json,
-        write_timeseries_csv,
-    )
+    from tailbeam.results_io import write_result_tables, write_timeseries_csv
     from tailbeam.scenarios import SCENARIOS
     from tailbeam.scene_file import scene_to_dict
 
@@ -94,8 +90,7 @@ def _write_scenarios(tmp, results) -> None:
         scenario = SCENARIOS[key]
         sub = tmp / key
         sub.mkdir()
-        write_impacts_csv(sub / "impacts.csv", result.impacts)
         echo = scene_to_dict(scenario.scene())
-        write_json(sub / "impacts.json", result_summary(result, echo))
+        write_result_tables(sub, result, echo)
         write_timeseries_csv(sub / "timeseries.csv", result, echo["sample_rate"])
         scenario_figures(result, scenario, tmp, sample_rate=echo["sample_rate"])

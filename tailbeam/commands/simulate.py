@@ -1,10 +1,10 @@
 """`tailbeam simulate SCENE.toml [--out DIR]`: simulate a scene file and write its results.
 
-Writes impacts.csv, impacts.json, timeseries.csv (uniform grid) and manifest.json into DIR;
-for a modal plate also sensors.csv, sensor_spectra.csv and one sensor_<name>.png (time and
-spectrum) per sensor. A scene the stream solver runs (streams, an inclined plate, balls that
-may touch) writes impacts.csv with the stream columns, particles.csv, impacts.json and
-manifest.json (tailbeam.solvers.stream_result).
+Writes impacts.csv (every column of ``Result.impacts_table``), particles.csv, impacts.json
+and manifest.json into DIR, for every scene (tailbeam.result); timeseries.csv (uniform grid)
+when the solver keeps the balls' states (single balls, rigid or modal plate: not the stream
+solver); on a modal plate with sensors also sensors.csv, sensor_spectra.csv and one
+sensor_<name>.png (time and spectrum) per sensor.
 
 Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
 scene and --out are fully validated before the solver runs, and the results replace DIR
@@ -31,56 +31,20 @@ def solve(scene):
     return simulate(scene)
 
 
-def _choices(result) -> dict:
-    """What was chosen automatically (band, basis), as recorded by the solver."""
-    info = getattr(result, "info", {}) or {}
-    return {k: info[k] for k in ("band", "basis", "solver") if k in info}
-
-
 def write_results(out_dir, scene, result) -> list:
     """Write every output file of ``result`` into ``out_dir`` (an existing directory)."""
-    if hasattr(result, "particles_table"):
-        return write_stream_results(out_dir, scene, result)
-    from tailbeam.results_io import (
-        result_summary,
-        write_impacts_csv,
-        write_json,
-        write_timeseries_csv,
-    )
+    from tailbeam.results_io import write_result_tables, write_timeseries_csv
     from tailbeam.scene_file import scene_to_dict
 
-    summary = result_summary(result, scene_to_dict(scene))
-    summary["automatic_choices"] = _choices(result)
-    files = [
-        write_impacts_csv(out_dir / "impacts.csv", result.impacts),
-        write_json(out_dir / "impacts.json", summary),
-        write_timeseries_csv(out_dir / "timeseries.csv", result, scene.sample_rate),
-    ]
-    if getattr(result, "sensors", ()):
-        n = len(result.sensors)
+    files = write_result_tables(out_dir, result, scene_to_dict(scene))
+    if result.keeps_states:
+        files.append(write_timeseries_csv(out_dir / "timeseries.csv", result, scene.sample_rate))
+    if scene.sensors and result.plate_model == "modal":
+        n = len(scene.sensors)
         with task(f"sensor replay and outputs, {n} sensors", total=n + 1, unit="steps") as bar:
             outputs = result.sensor_outputs  # the exact plate response through each chain
             bar.update(1)
             files += _write_sensors(out_dir, scene, result, outputs, bar)
-    return files
-
-
-def write_stream_results(out_dir, scene, result) -> list:
-    """impacts.csv (stream columns), particles.csv and impacts.json of a stream scene (no
-    timeseries.csv: the stream solvers keep no states, tailbeam.solvers.stream_result)."""
-    from tailbeam.results_io import stream_summary, write_json, write_table_csv
-    from tailbeam.scene_file import scene_to_dict
-    from tailbeam.solvers.stream_result import PARTICLE_UNITS, STREAM_IMPACT_UNITS
-
-    files = [
-        write_table_csv(out_dir / "impacts.csv", result.impacts_table(), STREAM_IMPACT_UNITS),
-        write_table_csv(out_dir / "particles.csv", result.particles_table(), PARTICLE_UNITS),
-        write_json(out_dir / "impacts.json", stream_summary(result, scene_to_dict(scene))),
-    ]
-    if result.sensors:
-        n = len(result.sensors)
-        with task(f"sensor outputs, {n} sensors", total=n, unit="sensors") as bar:
-            files += _write_sensors(out_dir, scene, result, result.sensors, bar)
     return files
 
 

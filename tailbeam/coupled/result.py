@@ -1,7 +1,8 @@
 """What a coupled (flexible-plate) simulation returns.
 
-The same attributes as ``tailbeam.rigid.RigidResult`` (impacts, events, rest_time, sample,
-time_grid, n_steps, status, message) plus the plate: ``modal_sample`` / ``plate_sample`` give the
+A ``tailbeam.result.Result`` with the same attributes as ``tailbeam.rigid.RigidResult``
+(impacts, events, rest_time, sample, time_grid, n_steps, status, message, impacts_table,
+particles_table) plus the plate: ``modal_sample`` / ``plate_sample`` give the
 exact modal state and the deflection, velocity and acceleration at any points and times (closed
 form between force nodes), and ``sensor_signals`` the accelerometer outputs.
 
@@ -9,19 +10,21 @@ The solution is stored as nodes: at each node time the ball heights, speeds and 
 the force is linear in time between nodes, so the balls are cubic and the modes exact there.
 """
 
-import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
 from tailbeam.coupled.propagator import replay
-from tailbeam.errors import InputError
+from tailbeam.result import BallsResult
 
 
 @dataclass(eq=False)
-class CoupledResult:
-    """Result of ``simulate_coupled``; see the module docstring."""
+class CoupledResult(BallsResult):
+    """Result of ``simulate_coupled``; see the module docstring. labels: coal / gangue per
+    ball (empty: ``tailbeam.scene.default_label``)."""
+
+    plate_model = "modal"
 
     balls: tuple
     laws: tuple
@@ -42,31 +45,20 @@ class CoupledResult:
     message: str = ""
     info: dict = field(default_factory=dict)
     _cross: dict = field(default_factory=dict, repr=False)  # residual cross compliances
+    labels: tuple = ()
 
     @property
     def nfev(self) -> int:
         """Contact-law evaluations are part of each step's Newton solve; counted as steps."""
         return self.n_steps
 
-    def impacts_of(self, name: str) -> list:
-        self._check_name(name)
-        return [imp for imp in self.impacts if imp.ball == name]
-
-    def events_of(self, name: str, kind: str | None = None) -> list:
-        return [(t, k) for t, b, k in self.events if b == name and (kind is None or k == kind)]
-
-    def _check_name(self, name):
-        if name not in [b.name for b in self.balls]:
-            raise InputError("name", f"no ball called {name!r}")
+    def _plate(self):
+        return self.basis.plate
 
     def sample(self, times) -> dict:
         """Ball states at ``times`` (s, within [0, duration]): name -> {"z" (m), "vz" (m/s),
         "force" (N)} arrays; exact (cubic between force nodes, closed form in flight)."""
-        t = np.atleast_1d(np.asarray(times, dtype=float))
-        if t.ndim != 1 or not np.all(np.isfinite(t)):
-            raise InputError("times", "must be a 1-D array of finite times in s")
-        if t.size and (t.min() < 0.0 or t.max() > self.duration * (1 + 1e-12)):
-            raise InputError("times", f"must lie within [0, duration = {self.duration!r}] s")
+        t = self._times(times, slack=1e-12)
         tn, zn, vn, fn, _dn = self.nodes
         k = np.clip(np.searchsorted(tn, t, side="right") - 1, 0, len(tn) - 1)
         k1 = np.minimum(k + 1, len(tn) - 1)
@@ -84,15 +76,6 @@ class CoupledResult:
             vz = vn[k, b] - self.gravity * s + (f0 * s + slope * s**2 / 2) / m
             out[ball.name] = {"z": z, "vz": vz, "force": f0 + slope * s}
         return out
-
-    def time_grid(self, sample_rate: float) -> np.ndarray:
-        """Uniform times at sample_rate (Hz) on [0, duration] merged with every peak time."""
-        if not sample_rate > 0:
-            raise InputError("sample_rate", f"must be > 0, got {sample_rate!r}")
-        n = int(math.floor(self.duration * sample_rate + 1e-9)) + 1
-        grid = np.arange(n) / sample_rate
-        peaks = [imp.t_peak for imp in self.impacts if math.isfinite(imp.t_peak)]
-        return np.unique(np.concatenate([grid, np.asarray(peaks, dtype=float)]))
 
     def modal_sample(self, times):
         """(q, q', q'') of every mode at ``times`` (s), each (n_modes, len(times)); exact."""
@@ -198,11 +181,6 @@ class CoupledResult:
                             max_frequency_hz=float(np.max(self.basis.frequencies_hz)))
             for s in self.sensors
         }  # fmt: skip
-
-    @property
-    def sensor_signals(self) -> dict:
-        """name -> (t array s, acceleration array m/s^2) as sampled by each sensor."""
-        return {name: (out.t, out.acceleration) for name, out in self.sensor_outputs.items()}
 
 
 def _difference_step(t, f_top):

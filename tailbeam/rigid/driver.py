@@ -82,6 +82,7 @@ def run(pairs, plate, balls, laws, duration, integrate_contact, *, max_contacts,
         n_steps=sum(st.n_steps for st in states),
         status=0,
         message="reached the end of the simulation (duration)",
+        plate=plate,
     )
 
 

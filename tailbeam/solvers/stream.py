@@ -86,8 +86,9 @@ def simulate_stream(
         clamp=laws.clamp, exponent=laws.exponent, rtol=rtol, rest_speed=rest_speed,
         max_work=max_steps, progress=progress, plate=plate,
     )  # fmt: skip
+    events = [(t, ball, kind, partner) for t, kind, ball, partner in run.events]
     result = StreamResult(
-        run.particles, run.contacts, run.leaves, run.events, incline, duration,
+        run.particles, run.contacts, run.leaves, events, incline, duration,
         status=run.status, message=run.message, stats=run.stats,
         info={"solver": "fast stream solver (event-driven, active-set DOP853)"},
     )  # fmt: skip

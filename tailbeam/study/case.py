@@ -13,7 +13,6 @@ import traceback
 import numpy as np
 
 from tailbeam.progress import quiet
-from tailbeam.results_io import IMPACT_COLUMNS
 
 
 def basis_signature(scene) -> str:
@@ -71,20 +70,10 @@ def _one_line(err: BaseException) -> str:
     return f"{type(err).__name__}: {text[0] if text else ''}".strip()
 
 
-def _impact_rows(result, coal: tuple) -> list:
-    material = {b.name: b.material.name for b in result.balls}
-    rows = []
-    for imp in result.impacts:
-        row = {c: getattr(imp, c) for c in IMPACT_COLUMNS}
-        row["material"] = material[imp.ball]
-        row["class"] = "coal" if material[imp.ball] in coal else "gangue"
-        rows.append(row)
-    return rows
-
-
-def _stream_rows(result) -> list:
-    """impacts_table() of a StreamResult as row dicts (every stream column), plus ``class``
-    (= the striking particle's ``label``: the stream decides what is gangue)."""
+def _impact_rows(result) -> list:
+    """impacts_table() (every impacts.csv column) as row dicts, plus ``class`` (= the
+    striking ball's ``label``: the scene's, which the sweep sets from ``labels.coal`` for
+    ``[[balls]]``; a stream decides what is gangue)."""
     table = result.impacts_table()
     names = list(table)
     rows = [dict(zip(names, values, strict=True)) for values in zip(*table.values(), strict=True)]
@@ -94,9 +83,9 @@ def _stream_rows(result) -> list:
 
 
 def _counts(rows: list, stream: bool) -> dict:
-    """Coal and gangue impacts on the plate (a stream's ball-ball rows are not plate
-    impacts) and, for streams, the number of ball-ball contacts (each gives two rows)."""
-    plate = [r for r in rows if not stream or r["partner"] == "plate"]
+    """Coal and gangue impacts on the plate (ball-ball rows are not plate impacts) and, for
+    streams, the number of ball-ball contacts (each gives two rows)."""
+    plate = [r for r in rows if r["partner"] == "plate"]
     classes = [r["class"] for r in plate]
     out = {"n_coal_impacts": classes.count("coal"), "n_gangue_impacts": classes.count("gangue")}
     if stream:
@@ -104,12 +93,13 @@ def _counts(rows: list, stream: bool) -> dict:
     return out
 
 
-def run_case(scene_toml: str, coal: tuple, *_after) -> dict:
+def run_case(scene_toml: str, *_after) -> dict:
     """Simulate one case. Returns {"status": "ok" | "failed", "error", "wall_time",
     "cpu_time" (s, this process),
     "signals": {sensor: float32 array m/s^2}, "impacts": [row dicts], "n_coal_impacts",
     "n_gangue_impacts" (plate impacts), and for a stream scene "n_ball_contacts"}.
-    ``_after`` are ignored (Dask dependencies, e.g. the warmed basis)."""
+    ``_after`` are ignored (Dask dependencies, e.g. the warmed basis; callers before the
+    labels moved into the scene passed the coal materials here)."""
     from tailbeam.commands.simulate import solve
     from tailbeam.scene_file import loads_scene
 
@@ -129,7 +119,7 @@ def run_case(scene_toml: str, coal: tuple, *_after) -> dict:
                 name: np.asarray(a, dtype=np.float32)
                 for name, (_t, a) in result.sensor_signals.items()
             }
-            out["impacts"] = _stream_rows(result) if stream else _impact_rows(result, coal)
+            out["impacts"] = _impact_rows(result)
             out["status"] = "ok"
     except Exception as err:  # noqa: BLE001 - any failure is recorded, never raised
         out["error"] = _one_line(err) or traceback.format_exc().splitlines()[-1]

@@ -9,8 +9,8 @@
   Attributes: units, sample rate (Hz), duration (s), the base sensor positions, the tailbeam
   version, the sweep file, and ``case_scenes`` (case hash -> the case's scene TOML).
   Finished cases are appended along ``case``; open it with ``xarray.open_zarr(DIR/dataset.zarr)``.
-- ``impacts.parquet``: one row per impact of every finished case (``case``, ``case_hash``, the
-  impacts.csv columns, the ball's ``material`` and ``class``).
+- ``impacts.parquet``: one row per impact of every finished case (``case``, ``case_hash``,
+  every impacts.csv column, ``class`` = the ball's ``label``).
 - ``cases.csv``: one row per case run so far: ``case``, ``case_hash``, ``status`` (ok | failed),
   ``error`` (one line), ``wall_time`` and ``cpu_time`` (s, on the worker), seed, repeat,
   labels and the swept values.

@@ -8,6 +8,7 @@ A sweep file names a base scene and the axes that vary::
 
     [labels]
     coal = ["coal"]              # materials counted as coal; every other material is gangue
+                                 # (the label of each [[balls]] entry that gives none)
 
     [axes]
     "balls.rock.material" = ["coal", "sandstone"]                  # a list: grid values
@@ -319,12 +320,13 @@ def _plain(v):
     return v.item() if isinstance(v, np.generic) else v
 
 
-def case_labels(scene, coal: tuple) -> dict:
+def case_labels(scene) -> dict:
     """Labels of a scene: class of the balls ("coal", "gangue" or "mixed"), gangue mass
-    fraction, numbers of coal and gangue balls (stream scenes: stream_labels)."""
+    fraction, numbers of coal and gangue balls, from the scene's ball labels (the sweep sets
+    them from ``labels.coal``: ``label_balls``; stream scenes: stream_labels)."""
     if scene.streams:
         return stream_labels(scene)
-    is_coal = [b.material.name in coal for b in scene.balls]
+    is_coal = [label == "coal" for label in scene.labels]
     mass = sum(b.mass for b in scene.balls)
     gangue_mass = sum(b.mass for b, c in zip(scene.balls, is_coal, strict=True) if not c)
     n_coal = sum(is_coal)
@@ -336,6 +338,17 @@ def case_labels(scene, coal: tuple) -> dict:
         "n_coal": n_coal,
         "n_gangue": n_gangue,
     }
+
+
+def label_balls(data: dict, coal: tuple) -> None:
+    """Give every ``[[balls]]`` table of the raw scene ``data`` that has no ``label`` the
+    label of its material: coal if it is in ``coal``, else gangue (in place). The scene
+    TOML then carries it where it differs from the default (tailbeam.scene.default_label),
+    and every output (impacts.csv's ``label``) agrees with the sweep's labels."""
+    balls = data.get("balls")
+    for ball in balls if isinstance(balls, list) else []:
+        if isinstance(ball, dict) and "label" not in ball and isinstance(ball.get("material"), str):
+            ball["label"] = "coal" if ball["material"] in coal else "gangue"
 
 
 def stream_labels(scene) -> dict:
@@ -393,6 +406,7 @@ def make_case(spec: SweepSpec, params: dict, repeat: int, number: int):
         set_value(data, key, value)
     _seed_noise(data, seed)
     _seed_streams(data, seed, params)
+    label_balls(data, spec.coal)
     shown = ", ".join(f"{k} = {v!r}" for k, v in params.items())
     try:
         scene = parse_scene(data)
@@ -400,7 +414,7 @@ def make_case(spec: SweepSpec, params: dict, repeat: int, number: int):
         raise InputError(f"case {number} ({shown}): {err.field}", err.rule) from None
     toml = dumps_scene(scene) + f"# case seed = {seed}\n"
     digest = hashlib.sha256(toml.encode()).hexdigest()
-    labels = case_labels(scene, spec.coal)
+    labels = case_labels(scene)
     xy = tuple((float(s.position[0]), float(s.position[1])) for s in scene.sensors)
     return Case(params, repeat, seed, toml, digest, labels, basis_signature(scene), xy), scene
 

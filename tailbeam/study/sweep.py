@@ -132,7 +132,7 @@ def plan(spec, out_dir, cases=None):
     return cases, todo, store
 
 
-def _submit(client, todo: list, coal: tuple) -> dict:
+def _submit(client, todo: list) -> dict:
     """Submit the basis warm-up tasks and the case tasks (one task per case, one
     ``client.map`` call per basis); future -> case."""
     groups = {}  # basis signature -> [case]
@@ -145,7 +145,7 @@ def _submit(client, todo: list, coal: tuple) -> dict:
         keys = [f"tailbeam-case-{c.hash[:16]}-{uuid.uuid4().hex[:8]}" for c in members]
         tomls = [c.toml for c in members]
         for fut, case in zip(
-            client.map(run_case, tomls, [coal] * n, [warm] * n, key=keys), members, strict=True
+            client.map(run_case, tomls, [warm] * n, key=keys), members, strict=True
         ):
             futures[fut] = case
     return futures
@@ -198,7 +198,7 @@ def run_sweep(spec, out_dir, *, workers=None, scheduler=None, client=None, cases
     t0 = time.perf_counter()
     write_s = 0.0
     try:
-        futures = _submit(client, todo, spec.coal)
+        futures = _submit(client, todo)
         batch = _Batch()
         with task(f"sweep of {len(todo)} cases", total=len(todo), unit="cases") as bar:
             for done in as_completed(list(futures)).batches():

@@ -118,8 +118,9 @@ def feature_table(
     if n < 16:
         raise InputError("--length", f"must span at least 16 samples, {16 / fs:g} s")
     impacts = pd.read_parquet(folder / "impacts.parquet") if window == "impact" else None
-    if impacts is not None and "partner" in impacts.columns:  # a stream's: plate rows only
-        impacts = impacts[impacts["partner"] == "plate"]
+    if impacts is not None and "partner" in impacts.columns:  # plate rows only (a dataset
+        # written before every scene had ``partner`` holds plate rows only: empty cells)
+        impacts = impacts[impacts["partner"].fillna("plate") == "plate"]
     if impacts is not None and first_only:
         impacts = impacts[impacts["index"] == 1]
     cases = case_table(ds)

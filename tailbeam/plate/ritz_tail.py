@@ -1,0 +1,166 @@
+"""Load-dependent Ritz pseudo-modes of the modes a band leaves out, at fixed load points.
+
+A modal basis cut at a band edge leaves out the "tail" of the spectrum. At a contact the tail
+acts through its spectral measure sum_i (phi_i . f)^2 delta(lambda - lambda_i) (f the
+contact's load vector). The quasi-static residual keeps only its first moment (the static
+compliance); k load-dependent Ritz vectors (Wilson, Yuan and Dickens 1982) keep 2k moments:
+the Krylov space of K^-1 M started from the static residual K^-1 f - sum_kept phi phi^T f /
+omega^2, M-orthogonal to the kept modes, then Rayleigh-Ritz on (K, M). The k Ritz pairs are
+the k-node Gauss rule of the tail's measure in s = 1/lambda with weights (phi . f)^2 / lambda,
+so sum (z . f)^2 / omega^(2m+2) equals the tail's sum (phi . f)^2 / lambda^(m+1) for
+m < 2k. The vectors are K- and M-orthogonal to the kept modes and to each other, so they are
+ordinary extra modes (Rayleigh damping stays diagonal) with true plate shapes.
+
+Measured (docs/fe-convergence.md, "Many-node tails"): at a 20 kHz band, k = 16-32 per contact
+point brings the contact quantities of the test meshes to 2-7e-6 of the full FE solution
+(quasi-static residual 3.5e-5), k = 48-128 on the default Argyris 23x23 mesh. This module only
+builds them for load points known in advance (``with_ritz_tail``: one falling ball, the FE
+cross-checks); the coupled solver does not create them per contact.
+"""
+
+import numpy as np
+from scipy.linalg import eigh
+
+from tailbeam.errors import InputError, WorkLimitError, require_nonnegative, require_positive
+from tailbeam.modal import ModalBasis
+from tailbeam.plate.model import check_points
+
+MAX_RITZ_VECTORS = 1024  # k x points: memory n_dofs x this x 8 B (250 MB at 30 000 DOFs)
+K_START = 16  # choose_ritz_k's first k (fewer ring coherently: docs/fe-convergence.md)
+BREAKDOWN = 1e-10  # a new Krylov vector this small against its start is dropped (exhausted)
+
+
+def ritz_tail_modes(basis, loads, k: int):
+    """Ritz pseudo-modes of ``basis``' truncated modes for the load vectors ``loads``.
+
+    basis: a ``FEModalBasis`` (``compute_modes``): its mode vectors (M-orthonormal, the kept
+        modes) and its FE model (K, M and the factorised K).
+    loads: (n_dofs, p) load vectors (N per unit force, ``PlateModel.load_vector``).
+    k: Krylov steps per load (block size p): up to k p pseudo-modes, fewer if the Krylov
+        space is exhausted.
+
+    Returns omega (m,) rad/s ascending and Z (n_dofs, m), Z^T M Z = I, Z^T K Z = diag(omega^2),
+    Phi_kept^T M Z = 0.
+    """
+    model, kept = basis.fe_model(), basis.mode_vectors
+    M, solve = model.mass, model.solver().solve
+    loads = np.asarray(loads, dtype=float).reshape(kept.shape[0], -1)
+    V = np.zeros((kept.shape[0], k * loads.shape[1]))
+    count, block = 0, solve(loads)
+    for _ in range(k):
+        fresh = []
+        for u in block.T:
+            start = np.sqrt(u @ (M @ u))
+            for _ in range(2):  # twice is enough (Kahan-Parlett)
+                u = u - kept @ (kept.T @ (M @ u))
+                u = u - V[:, :count] @ (V[:, :count].T @ (M @ u))
+            norm = np.sqrt(u @ (M @ u))
+            if norm > BREAKDOWN * start:
+                V[:, count] = u / norm
+                fresh.append(count)
+                count += 1
+        if not fresh:
+            break
+        block = solve(M @ V[:, fresh])
+    if count == 0:  # the loads move no truncated mode
+        return np.zeros(0), V[:, :0]
+    V = V[:, :count]
+    theta, Y = eigh(V.T @ (model.stiffness @ V), V.T @ (M @ V))
+    return np.sqrt(theta), V @ Y
+
+
+def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> ModalBasis:
+    """``basis`` plus k load-dependent Ritz pseudo-modes per load point (``ritz_tail_modes``).
+
+    points: (p, 2) m, where the loads act (the contact points, known in advance);
+    contact_radius: m, the load is 1 N spread over a disc of this radius (0: a point load;
+    use ``tailbeam.contact_patch.load_radius`` as the solver does). The pseudo-modes have
+    their true shapes (seen at sensors and other points), and the residual compliance of the
+    returned basis (static minus every mode it holds) is ~0 at the points. Raises InputError
+    for bad input, WorkLimitError if k x points exceeds MAX_RITZ_VECTORS.
+    """
+    _check_basis(basis)
+    _check_count("k", k, 1)
+    radius = require_nonnegative("contact_radius", contact_radius)
+    pts = check_points(basis.plate, points)
+    if k * len(pts) > MAX_RITZ_VECTORS:
+        raise WorkLimitError(
+            f"{k} Ritz vectors x {len(pts)} points > {MAX_RITZ_VECTORS}; lower k or the points"
+        )
+    model = basis.fe_model()
+    loads = np.column_stack([model.load_vector(p, radius) for p in pts])
+    omega, Z = ritz_tail_modes(basis, loads, int(k))
+    parent = basis.deflection_at
+
+    def deflection_at(at):
+        extra = model.deflection_operator(np.atleast_2d(at)) @ Z
+        return np.column_stack([np.asarray(parent(at)), extra])
+
+    info = dict(basis.info, ritz_tail={"k": int(k), "points": pts.tolist(), "added": len(omega)})
+    return ModalBasis(
+        basis.plate,
+        np.append(basis.frequencies_hz, omega / (2.0 * np.pi)),
+        deflection_at,
+        basis.theory,
+        basis.boundary,
+        basis.static_compliance_at,
+        basis.static_deflection_at,
+        info,
+    )
+
+
+def _check_basis(basis):
+    if getattr(basis, "mode_vectors", None) is None or not hasattr(basis, "fe_model"):
+        raise InputError("basis", "needs the FE mode vectors and model (use compute_modes)")
+
+
+def _check_count(field, value, least):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+        raise InputError(field, f"must be a whole number >= {least}, got {value!r}")
+
+
+def half_sine_response(omega, fz, duration: float, peak_force: float, t) -> np.ndarray:
+    """Deflection (m) under the load of pseudo-modes (omega (m,) rad/s, f.z (m,)) at rest,
+    driven by F = peak_force sin(pi t / duration) N at times t (s) within the contact:
+    q_j = F_peak (sin W t - (W / omega_j) sin omega_j t) / (omega_j^2 - W^2), W = pi/duration
+    (closed form; the tail lies far above W)."""
+    w = np.pi / duration
+    t = np.asarray(t, dtype=float)[:, None]
+    q = peak_force * (np.sin(w * t) - (w / omega) * np.sin(omega * t)) / (omega**2 - w**2)
+    return q @ (fz**2)
+
+
+def choose_ritz_k(basis, point, contact_radius, duration, peak_force, max_penetration,
+                  tol: float = 1e-5, k_max: int = 512):  # fmt: skip
+    """The number of Ritz pseudo-modes for one contact, a posteriori: k doubles from K_START
+    until the tail model's deflection under a half-sine force of ``duration`` s and
+    ``peak_force`` N changes from k to 2k by less than ``tol`` x ``max_penetration`` m (RMS over
+    the contact). Measured on the cases of docs/fe-convergence.md ("Many-node tails"): the
+    contact error with k pseudo-modes is then below 0.88 x tol, plus the time-step error.
+    Returns (k, that relative change). WorkLimitError if 2k would exceed ``k_max``."""
+    _check_basis(basis)
+    for name, value in (("duration", duration), ("peak_force", peak_force),
+                        ("max_penetration", max_penetration), ("tol", tol)):  # fmt: skip
+        require_positive(name, value)
+    _check_count("k_max", k_max, 2 * K_START)
+    if k_max > MAX_RITZ_VECTORS:
+        raise InputError("k_max", f"must be <= {MAX_RITZ_VECTORS}, got {k_max!r}")
+    model = basis.fe_model()
+    load = model.load_vector(check_points(basis.plate, point)[0], contact_radius)[:, None]
+    t = np.linspace(0.0, duration, 4001)
+
+    def response(k):
+        omega, Z = ritz_tail_modes(basis, load, k)
+        return half_sine_response(omega, (load.T @ Z)[0], duration, peak_force, t)
+
+    k, w_k = K_START, response(K_START)
+    while 2 * k <= k_max:
+        w_2k = response(2 * k)
+        change = float(np.sqrt(np.mean((w_2k - w_k) ** 2))) / max_penetration
+        if change < tol:
+            return k, change
+        k, w_k = 2 * k, w_2k
+    raise WorkLimitError(
+        f"the Ritz tail has not converged to tol={tol:g} with k_max={k_max} modes; raise tol "
+        "or k_max"
+    )

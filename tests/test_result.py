@@ -1,0 +1,201 @@
+"""One result type (tailbeam.result): the impacts.csv and particles.csv columns of [[balls]]
+scenes on the rigid and the modal plate.
+
+Independent truths: free fall (a ball dropped from rest at gap h strikes at t = sqrt(2 h / g)
+with speed sqrt(2 g h), where its centre is above its release point, or moved by its
+uniform lateral velocity), the ball's mass 4/3 pi r^3 rho, the scene's own balls and labels,
+the centre's crossing of the plate edge, the coupled solver's own contact points, and the
+stream solver (a separate solver with its own records) run on the same balls: the new columns
+of the single-ball solvers must mean what the stream solver writes.
+"""
+
+import csv
+import math
+
+import numpy as np
+import pytest
+
+import tailbeam
+from tailbeam.bodies import Ball
+from tailbeam.cli import main
+from tailbeam.errors import InputError
+from tailbeam.materials import COAL, SANDSTONE
+from tailbeam.result import IMPACT_COLUMNS, IMPACT_TABLE_COLUMNS, PARTICLE_COLUMNS, Result
+from tailbeam.scene import ModalPlateSettings, Scene
+from tailbeam.scene_file import dumps_scene
+from tailbeam.solvers.engine import stream_engine
+
+G = 9.80665
+GAPS = {"c": 0.02, "s": 0.03, "m": 0.01}  # drop gaps h (m): lowest point above the plate
+LATERAL = {"m": 1.0}  # m/s along x
+
+
+def balls(radii=None):
+    radii = radii or {"c": 0.03, "s": 0.025, "m": 0.02}
+    xy = {"c": (-0.1, 0.05), "s": (0.15, -0.1), "m": (0.2, 0.0)}
+    mats = {"c": COAL, "s": SANDSTONE, "m": COAL}
+    return tuple(
+        Ball(n, mats[n], radii[n], (*xy[n], radii[n] + GAPS[n]), (LATERAL.get(n, 0.0), 0.0, 0.0))
+        for n in ("c", "s", "m")
+    )
+
+
+@pytest.fixture(scope="module")
+def rigid_scene():
+    # "s" is sandstone labelled coal in the scene: the label column is the scene's, not a rule
+    return Scene(balls(), duration=0.15, labels=("coal", "coal", "coal"))
+
+
+@pytest.fixture(scope="module")
+def rigid(rigid_scene):
+    return tailbeam.simulate(rigid_scene, progress=False)
+
+
+def first_rows(table) -> dict:
+    """ball -> its first impacts.csv row (a dict)."""
+    out = {}
+    for k in range(len(table["ball"])):
+        row = {c: table[c][k] for c in table}
+        out.setdefault(row["ball"], row)
+    return out
+
+
+def check_free_fall_columns(table, scene, contact_xy=None):
+    """x, y, approach_in, partner, ... of every ball's first impact against free fall."""
+    assert tuple(table) == IMPACT_TABLE_COLUMNS
+    assert tuple(table)[:12] == IMPACT_COLUMNS
+    labels = dict(zip([b.name for b in scene.balls], scene.labels, strict=True))
+    first = first_rows(table)
+    assert set(first) == {b.name for b in scene.balls}
+    t_first = min(row["t_start"] for row in first.values())
+    for b in scene.balls:
+        row = first[b.name]
+        t_hit = row["t_start"]
+        if t_hit == t_first or scene.plate_model == "rigid":  # the plate is still at rest
+            h = GAPS[b.name]
+            assert t_hit == pytest.approx(math.sqrt(2.0 * h / G), rel=1e-9)
+            assert row["approach_in"] == pytest.approx(math.sqrt(2.0 * G * h), rel=1e-9)
+        # free fall from rest until the first touch (of a plate that may vibrate by then)
+        assert row["approach_in"] == pytest.approx(G * t_hit, rel=1e-9)
+        assert row["x"] == pytest.approx(b.position[0] + b.velocity[0] * t_hit, abs=1e-12)
+        assert row["y"] == b.position[1]
+        assert (row["partner"], row["stream"], row["end"]) == ("plate", "", "separated")
+        assert (row["material"], row["radius"]) == (b.material.name, b.radius)
+        assert row["label"] == labels[b.name]
+        # on a plate row the pair's speeds are the ball's normal speeds (the stream solver's
+        # definition, tailbeam.solvers.records.ContactRecord)
+        assert (row["approach_in"], row["approach_out"]) == (row["v_in"], row["v_out"])
+        if contact_xy is not None:  # where the solver applied the contact force
+            assert (row["x"], row["y"]) == pytest.approx(contact_xy[b.name], abs=1e-15)
+
+
+def check_particles(table, scene, leave=None):
+    """particles.csv: one row per ball, its release state, mass 4/3 pi r^3 rho, leave."""
+    leave = leave or {}
+    assert tuple(table) == PARTICLE_COLUMNS
+    assert list(table["name"]) == [b.name for b in scene.balls]
+    for k, b in enumerate(scene.balls):
+        mass = 4.0 / 3.0 * math.pi * b.radius**3 * b.material.density
+        assert table["mass"][k] == pytest.approx(mass, rel=1e-12)
+        assert (table["stream"][k], table["t_release"][k]) == ("", 0.0)
+        assert (table["material"][k], table["label"][k]) == (b.material.name, scene.labels[k])
+        state = [table[c][k] for c in ("x0", "y0", "z0", "vx0", "vy0", "vz0")]
+        assert state == [*b.position, *b.velocity]
+        if b.name in leave:
+            assert table["t_leave"][k] == pytest.approx(leave[b.name][0], rel=1e-12)
+            assert table["leave_edge"][k] == leave[b.name][1]
+        else:
+            assert math.isnan(table["t_leave"][k]) and table["leave_edge"][k] == ""
+
+
+def test_rigid_plate_columns_against_free_fall(rigid, rigid_scene):
+    assert isinstance(rigid, Result) and rigid.plate_model == "rigid"
+    check_free_fall_columns(rigid.impacts_table(), rigid_scene)
+    # "m" (x0 = 0.2 m, 1 m/s) passes the x+ edge (x = 0.3 m) at 0.1 s
+    check_particles(rigid.particles_table(), rigid_scene, leave={"m": (0.1, "x+")})
+    assert [e.ball for e in rigid.leaves] == ["m"]
+
+
+def test_rigid_columns_mean_what_the_stream_solver_writes(rigid, rigid_scene):
+    """The same balls through the stream solver (its own records): every column of
+    impacts.csv and particles.csv agrees (rtol 1e-10 both; measured <= 1.3e-9 relative)."""
+    scene = rigid_scene
+    stream = stream_engine().run(
+        scene.particles, scene.incline, scene.duration, laws=scene.contact, rtol=1e-10,
+        max_steps=10**6,
+    )  # fmt: skip
+    ours, theirs = rigid.impacts_table(), stream.impacts_table()
+    assert len(ours["ball"]) == len(theirs["ball"]) == 3
+    for c in IMPACT_TABLE_COLUMNS:
+        if ours[c].dtype == object or c in ("index", "ends_at_rest"):
+            assert list(ours[c]) == list(theirs[c]), c
+        else:
+            assert ours[c] == pytest.approx(theirs[c], rel=1e-8, abs=1e-12), c
+    ours, theirs = rigid.particles_table(), stream.particles_table()
+    for c in PARTICLE_COLUMNS:
+        if ours[c].dtype == object:
+            assert list(ours[c]) == list(theirs[c]), c
+        else:
+            assert ours[c] == pytest.approx(theirs[c], rel=1e-9, nan_ok=True), c
+    for name in ("c", "s", "m"):  # the contact events of both, in the one format
+        mine = [t for t, _k in rigid.events_of(name, "contact_start")]
+        assert mine == pytest.approx([t for t, _k in stream.events_of(name, "contact_start")])
+
+
+def test_simulate_writes_the_tables_bit_for_bit(rigid_scene, tmp_path, capsys):
+    path = tmp_path / "scene.toml"
+    path.write_text(dumps_scene(rigid_scene))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "o"), "-q"]) == 0
+    result = tailbeam.simulate(rigid_scene, progress=False)
+    for name, table in (
+        ("impacts.csv", result.impacts_table()),
+        ("particles.csv", result.particles_table()),
+    ):
+        with open(tmp_path / "o" / name, newline="") as fh:
+            header, *rows = list(csv.reader(fh))
+        assert header == list(table)
+        for k, row in enumerate(rows):
+            for c, cell in zip(header, row, strict=True):
+                value = table[c][k]
+                if isinstance(value, str):
+                    assert cell == value
+                elif isinstance(value, bool | np.bool_):
+                    assert cell == ("true" if value else "false")
+                else:
+                    assert repr(float(cell)) == repr(float(value))
+
+
+def test_events_and_sample_of_the_one_interface(rigid):
+    starts = [t for t, _k in rigid.events_of("c", "contact_start")]
+    assert starts == [imp.t_start for imp in rigid.impacts_of("c")]
+    assert rigid.stats == {"nfev": rigid.nfev, "n_steps": rigid.n_steps}
+    assert rigid.sensor_signals == {} and rigid.keeps_states
+    with pytest.raises(InputError, match="name"):
+        rigid.impacts_of("nobody")
+
+
+def test_modal_plate_columns_against_free_fall():
+    """Two balls on the modal plate (the coupled solver), one moving sideways: first impacts
+    against free fall (the plate is at rest until then) and the solver's contact points."""
+    scene = Scene(
+        balls({"c": 0.03, "s": 0.02, "m": 0.02})[::2],  # "c" and "m" (sideways)
+        duration=0.07,
+        plate_model="modal",
+        modal=ModalPlateSettings(fmax_hz=2000.0),
+    )
+    result = tailbeam.simulate(scene, progress=False)
+    assert result.plate_model == "modal" and result.keeps_states
+    names = [b.name for b in scene.balls]
+    points = {names[b]: (x, y) for t, b, x, y, _r in reversed(result.contact_points)}
+    check_free_fall_columns(result.impacts_table(), scene, contact_xy=points)
+    check_particles(result.particles_table(), scene)
+
+
+def test_a_stream_result_keeps_no_states():
+    stream = stream_engine().run(
+        Scene(balls()[:1], duration=0.01).particles, Scene(balls()[:1]).incline, 0.01,
+        laws=Scene(balls()[:1]).contact, rtol=1e-10, max_steps=10**5,
+    )  # fmt: skip
+    assert not stream.keeps_states and stream.plate_model == "rigid"
+    with pytest.raises(InputError, match="times"):
+        stream.sample([0.0])
