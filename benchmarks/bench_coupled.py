@@ -31,6 +31,7 @@ from scipy.integrate import solve_ivp
 
 from tailbeam.bodies import STANDARD_GRAVITY as G
 from tailbeam.bodies import Ball, Plate
+from tailbeam.contact_law import impact_force_array
 from tailbeam.coupled import simulate_coupled
 from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
@@ -89,12 +90,7 @@ def run_baseline(basis, balls, laws, duration, method, rtol):
 
     def force(y):
         z, vz, q, qd = y[:nb], y[nb : 2 * nb], y[2 * nb : 2 * nb + n], y[2 * nb + n :]
-        delta = rad - z + phi @ q
-        ddot = -vz + phi @ qd
-        pos = np.maximum(delta, 0.0)
-        s = np.clip(pos / d, 0.0, 1.0)
-        f = k * pos**1.5 + c * s * s * (3 - 2 * s) * ddot
-        f = np.where(delta > 0, np.maximum(f, 0.0), 0.0)
+        f = impact_force_array(rad - z + phi @ q, -vz + phi @ qd, k, 1.5, c, d, True)
         return np.where(resting, m * G, f)
 
     def rhs(_t, y):
@@ -116,12 +112,8 @@ def run_baseline(basis, balls, laws, duration, method, rtol):
     def force_cols(ys, times):
         z, vz = ys[:nb], ys[nb : 2 * nb]
         q, qd = ys[2 * nb : 2 * nb + n], ys[2 * nb + n :]
-        delta = rad[:, None] - z + phi @ q
-        ddot = -vz + phi @ qd
-        pos = np.maximum(delta, 0.0)
-        s = np.clip(pos / d[:, None], 0.0, 1.0)
-        f = k[:, None] * pos**1.5 + c[:, None] * s * s * (3 - 2 * s) * ddot
-        f = np.where(delta > 0, np.maximum(f, 0.0), 0.0)
+        delta, ddot = rad[:, None] - z + phi @ q, -vz + phi @ qd
+        f = impact_force_array(delta, ddot, k[:, None], 1.5, c[:, None], d[:, None], True)
         return np.where(times[None, :] >= rest_t[:, None], (m * G)[:, None], f)
 
     def sensor_acc(ys, times):

@@ -60,16 +60,22 @@ def _same(a, b):
             and all(a[k] == b[k] for k in ("log", "stats", "contacts")))  # fmt: skip
 
 
+def extract_revision(base, tmp: Path) -> Path:
+    """``tailbeam`` and ``tests`` of git revision ``base``, extracted into tmp/base."""
+    old = tmp / "base"
+    old.mkdir()
+    archive = subprocess.run(["git", "archive", base, "tailbeam", "tests"], cwd=ROOT,
+                             check=True, capture_output=True).stdout  # fmt: skip
+    (tmp / "base.tar").write_bytes(archive)
+    with tarfile.open(tmp / "base.tar") as tar:
+        tar.extractall(old, filter="data")
+    return old
+
+
 def main(base):
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        old = tmp / "base"
-        old.mkdir()
-        archive = subprocess.run(["git", "archive", base, "tailbeam", "tests"], cwd=ROOT,
-                                 check=True, capture_output=True).stdout  # fmt: skip
-        (tmp / "base.tar").write_bytes(archive)
-        with tarfile.open(tmp / "base.tar") as tar:
-            tar.extractall(old, filter="data")
+        old = extract_revision(base, tmp)
         _run_in(old, tmp / "old.pkl", tmp / "cache-base")
         _run_in(ROOT, tmp / "new.pkl", tmp / "cache-new")
         a = pickle.loads((tmp / "old.pkl").read_bytes())

@@ -8,16 +8,19 @@ delta_dot (m/s, > 0 while approaching), Adams evaluates
 
 k in N/m^e, c in N s/m, d in m. The max(0, .) clamp is Adams' behaviour; the paper's eq. 1
 leaves it out (``clamp=False`` reproduces eq. 1 literally, with its adhesive pull at the end of
-rebound). ``impact_force_scalar`` and ``step_scalar`` are written so numba can compile them.
+rebound). The law's formula is written once, in ``tailbeam.physics.impact`` (numba); this
+module holds the parameters (``ImpactLaw``, Hertz stiffness) and array wrappers of that core.
 """
 
 import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import vectorize
 
 from tailbeam.errors import InputError, require_nonnegative, require_positive
 from tailbeam.materials import Material, effective_modulus
+from tailbeam.physics import impact
 
 HERTZ_EXPONENT = 1.5
 
@@ -102,103 +105,84 @@ def ball_ball_law(
     return ImpactLaw(k, exponent, damping, penetration, clamp)
 
 
-def step_scalar(x: float, x0: float, h0: float, x1: float, h1: float) -> float:
-    """Adams STEP: h0 for x <= x0, h1 for x >= x1, cubic h0 + (h1-h0) s^2 (3 - 2 s) between.
+# --- Array wrappers of the law's one definition (tailbeam.physics.impact) ------------------
+# numba ufuncs (compiled on first use, cached) that call the scalar core, so the formula is
+# written once: they broadcast like numpy ('law' may hold arrays of parameters, one per pair;
+# ``ramp`` / ``clamped`` arrays of flags). The region forms serve integrators that stop at every
+# kink: ``ramp`` (delta < d: damping c STEP(delta, 0, 0, d, c), the cubic extended past d) or
+# full damping (c), and ``clamped`` (Adams' max(0, .) active: force 0).
 
-    The cubic has zero slope at both ends, so STEP is C1 (its second derivative jumps).
-    """
-    if x <= x0:
-        return h0
-    if x >= x1:
-        return h1
-    s = (x - x0) / (x1 - x0)
-    return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
+step_scalar = impact.step
+"""Adams STEP of floats (``tailbeam.physics.impact.step``)."""
+
+impact_force_scalar = impact.force
+"""IMPACT force in N of floats: (delta m, delta_dot m/s, stiffness, exponent, damping,
+penetration, clamp) (``tailbeam.physics.impact.force``)."""
+
+
+@vectorize(cache=True)
+def _step(x, x0, h0, x1, h1):
+    return impact.step(x, x0, h0, x1, h1)
+
+
+@vectorize(cache=True)
+def impact_force_array(delta, rate, k, e, c, d, clamp):
+    """``impact_force_scalar`` as a ufunc: every argument may be an array (one per pair)."""
+    return impact.force(delta, rate, k, e, c, d, clamp)
+
+
+@vectorize(cache=True)
+def _region_damping(delta, c, d, ramp):
+    return impact.region_damping(delta, c, d, ramp)
+
+
+@vectorize(cache=True)
+def _region_force(delta, rate, k, e, c, d, ramp, clamped):
+    return impact.region_force(delta, rate, k, e, c, d, ramp, clamped)
+
+
+@vectorize(cache=True)
+def _elastic_energy(delta, k, e):
+    return impact.elastic_energy(delta, k, e)
 
 
 def step(x, x0: float, h0: float, x1: float, h1: float):
     """Array version of ``step_scalar``."""
-    x = np.asarray(x, dtype=float)
-    s = np.clip((x - x0) / (x1 - x0), 0.0, 1.0)
-    return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
-
-
-def impact_force_scalar(
-    delta: float,
-    delta_dot: float,
-    stiffness: float,
-    exponent: float,
-    damping: float,
-    penetration: float,
-    clamp: bool,
-) -> float:
-    """IMPACT force in N for penetration ``delta`` (m) and rate ``delta_dot`` (m/s)."""
-    if delta <= 0.0:
-        return 0.0
-    force = stiffness * delta**exponent + step_scalar(delta, 0.0, 0.0, penetration, damping) * (
-        delta_dot
-    )
-    if clamp and force < 0.0:
-        return 0.0
-    return force
+    return _step(np.asarray(x, dtype=float), x0, h0, x1, h1)
 
 
 def impact_force(delta, delta_dot, law: ImpactLaw):
-    """Array version of ``impact_force_scalar`` for an ``ImpactLaw``."""
-    delta = np.asarray(delta, dtype=float)
-    delta_dot = np.asarray(delta_dot, dtype=float)
-    inside = delta > 0.0
-    pos = np.where(inside, delta, 0.0)
-    force = law.stiffness * pos**law.exponent + step(
-        pos, 0.0, 0.0, law.penetration, law.damping
-    ) * (delta_dot)
-    if law.clamp:
-        force = np.maximum(force, 0.0)
-    return np.where(inside, force, 0.0)
-
-
-# --- The law region by region (for integrators that stop at every kink) -------------------
-# A kink-respecting integrator (the slow references) integrates each region of the law with
-# that region's smooth formula, extended past the region's borders, and stops at the border.
-# Regions: ``ramp`` (delta < d: damping c STEP(delta, 0, 0, d, c)) or full damping (delta >= d:
-# damping c), and ``clamped`` (Adams' max(0, .) active: force 0). These helpers are the same
-# law as ``impact_force`` (tests/test_contact_law_regions.py checks they agree in each region).
+    """IMPACT force in N (arrays) of penetrations ``delta`` (m) and rates ``delta_dot`` (m/s)
+    under ``law``."""
+    return impact_force_array(_floats(delta), _floats(delta_dot), *_parameters(law), law.clamp)
 
 
 def damping_in_region(delta, law: ImpactLaw, ramp):
     """Damping coefficient in N s/m: the STEP cubic (extended past [0, d]) where ``ramp``,
-    else c. Array-friendly: ``law`` may hold arrays of parameters (one per pair) and
-    ``ramp`` an array of flags."""
-    s = np.asarray(delta, dtype=float) / law.penetration
-    return np.where(ramp, law.damping * s * s * (3.0 - 2.0 * s), law.damping)
+    else c."""
+    return _region_damping(_floats(delta), law.damping, law.penetration, ramp)
 
 
 def impact_force_in_region(delta, delta_dot, law: ImpactLaw, ramp, clamped):
-    """Force in N of one region's smooth formula; delta <= 0 gives the elastic term 0.
-
-    Array-friendly like ``damping_in_region`` (``clamped``: flags, force 0 where set)."""
-    pos = np.maximum(np.asarray(delta, dtype=float), 0.0)
-    raw = law.stiffness * pos**law.exponent + damping_in_region(pos, law, ramp) * delta_dot
-    return np.where(clamped, 0.0, raw)
+    """Force in N of one region's smooth formula; delta <= 0 gives the elastic term 0; 0 where
+    ``clamped``."""
+    return _region_force(_floats(delta), _floats(delta_dot), *_parameters(law), ramp, clamped)
 
 
 def clamp_indicator(delta: float, delta_dot: float, law: ImpactLaw, ramp: bool) -> float:
-    """raw force / (k delta^e): the sign of the unclamped force, not 0 at delta = 0.
-
-    Its zero is the clamp kink (clamp on/off); unlike the force it does not vanish at
-    separation, so the clamp events never coincide with contact end. At delta <= 0: the limit
-    at delta -> 0+.
-    """
-    k, e, c, d = law.stiffness, law.exponent, law.damping, law.penetration
-    if delta > 0.0:
-        return 1.0 + float(damping_in_region(delta, law, ramp)) * delta_dot / (k * delta**e)
-    if ramp and e < 2.0:
-        return 1.0
-    if ramp and e == 2.0:
-        return 1.0 + 3.0 * c * delta_dot / (k * d * d)
-    return -1.0 if delta_dot < 0.0 else 1.0
+    """Unclamped force / (k delta^e): the sign of the unclamped force, not 0 at delta = 0
+    (``tailbeam.physics.impact.clamp_indicator``)."""
+    return impact.clamp_indicator(float(delta), float(delta_dot), *_parameters(law), bool(ramp))
 
 
 def elastic_energy(delta, law: ImpactLaw):
     """Energy in J stored by the elastic term: k delta^(e+1) / (e+1) for delta > 0, else 0."""
-    pos = np.maximum(np.asarray(delta, dtype=float), 0.0)
-    return law.stiffness * pos ** (law.exponent + 1.0) / (law.exponent + 1.0)
+    return _elastic_energy(_floats(delta), law.stiffness, law.exponent)
+
+
+def _parameters(law):
+    return law.stiffness, law.exponent, law.damping, law.penetration
+
+
+def _floats(x):
+    return np.asarray(x, dtype=float)

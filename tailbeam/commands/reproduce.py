@@ -15,6 +15,7 @@ input, as every command).
 from tailbeam.cachedir import announce_first_compile
 from tailbeam.output import atomic_output_dir, check_output_dir
 from tailbeam.progress import task
+from tailbeam.solvers.records import EventKind
 
 # The solver, figures and claims are imported in run(), so `tailbeam --help` stays fast.
 
@@ -44,7 +45,7 @@ def clamp_summary(results, results_off, claims_off) -> str:
             changes.append(off - on)
     worst = max(changes, key=abs)
     n = sum(c.passed for c in claims_off)
-    acted = sum(1 for r in results.values() for e in r.events if e[2] == "clamp_on")
+    acted = sum(1 for r in results.values() for e in r.events if e[2] == EventKind.CLAMP_ON)
     return (
         f"without Adams' clamp (eq. 1 as printed): {n} of {len(claims_off)} claims hold; "
         f"largest change of first-impact restitution {worst:+.3g} "

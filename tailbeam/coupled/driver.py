@@ -18,15 +18,16 @@ from tailbeam.coupled.result import CoupledResult
 from tailbeam.errors import WorkLimitError
 from tailbeam.hertz import hertz_contact_duration
 from tailbeam.progress import task
+from tailbeam.solvers.records import EventKind
 
 NODE_CAPACITY = 65536  # nodes of the first buffers (they double when full)
 EVENT_NAMES = {
-    K.EV_START: "contact_start",
-    K.EV_END: "contact_end",
-    K.EV_DEEP: "full_damping",
-    K.EV_SHALLOW: "full_damping",
-    K.EV_CLAMP_ON: "clamp_on",
-    K.EV_CLAMP_OFF: "clamp_off",
+    K.EV_START: EventKind.CONTACT_START,
+    K.EV_END: EventKind.CONTACT_END,
+    K.EV_DEEP: EventKind.FULL_DAMPING,
+    K.EV_SHALLOW: EventKind.FULL_DAMPING,
+    K.EV_CLAMP_ON: EventKind.CLAMP_ON,
+    K.EV_CLAMP_OFF: EventKind.CLAMP_OFF,
 }
 
 
@@ -260,7 +261,7 @@ class CoupledRun:
         """Record ball b's rest (time, event) and a node at this instant."""
         name = self.balls[b].name
         self.rest_time[name] = self.t
-        self.events.append((self.t, name, "rest"))
+        self.events.append((self.t, name, EventKind.REST))
         bt, bz, bvz, bF, bd = self.bufs
         if self.nbuf >= len(bt):
             raise WorkLimitError("node buffer full at a rest declaration; raise max_steps")

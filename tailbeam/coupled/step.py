@@ -6,6 +6,8 @@ forces at the step's end solve, by Newton's method on the few active contacts,
 
     F_j = IMPACT(delta_j, delta_dot_j),   delta_j = R_j - z_j + w_j - C_j F_j,
 
+(the law and its partial derivatives: ``tailbeam.physics.impact.force_partials``)
+
 with w_j = sum_i phi_ji q_i the plate under ball j (two-way coupling) and C_j the residual
 compliance of the truncated modes (quasi-static, in series with the contact; its rate term uses
 a variable-step BDF2 derivative of F, so the scheme stays 2nd order). delta_j is linear in the
@@ -16,26 +18,9 @@ import numpy as np
 from numba import njit
 
 from tailbeam.coupled.propagator import A1, B1, advance, coefficients
+from tailbeam.physics.impact import force_partials
 
 FLIGHT, CONTACT, CLAMPED, REST, OFF = 0, 1, 2, 3, 4
-
-
-@njit(cache=True)
-def _law(delta, ddot, k, e, c, d, clamp):
-    """IMPACT force and its partial derivatives in delta and delta_dot; raw (unclamped) force."""
-    if delta <= 0.0:
-        return 0.0, 0.0, 0.0, 0.0
-    if delta >= d:
-        st = c
-        dst = 0.0
-    else:
-        s = delta / d
-        st = c * s * s * (3.0 - 2.0 * s)
-        dst = c * 6.0 * s * (1.0 - s) / d
-    raw = k * delta**e + st * ddot
-    if clamp and raw < 0.0:
-        return 0.0, 0.0, 0.0, raw
-    return raw, k * e * delta ** (e - 1.0) + dst * ddot, st, raw
 
 
 @njit(cache=True)
@@ -103,7 +88,7 @@ def solve_step(tau, ctx, st, out, g):
                 for ll in range(na):
                     dl += S[jj, ll] * x[ll]
                     dv += Sv[jj, ll] * x[ll]
-                f, fd, fv, _raw = _law(dl, dv, k[j], e[j], c[j], d[j], clampf[j])
+                f, fd, fv, _raw = force_partials(dl, dv, k[j], e[j], c[j], d[j], clampf[j])
                 r[jj] = x[jj] - f
                 big = max(big, abs(f))
                 for ll in range(na):
@@ -140,7 +125,7 @@ def solve_step(tau, ctx, st, out, g):
         beta = tau / (tau + hist[1, b]) if hist[1, b] > 0.0 else 0.0
         fdot = (1.0 + beta) * (F1[b] - F[b]) / tau - beta * hist[0, b]
         aux[1, b] = -vz1[b] + wd - cres[b] * fdot
-        _f, _fd, _fv, raw = _law(aux[0, b], aux[1, b], k[b], e[b], c[b], d[b], False)
+        _f, _fd, _fv, raw = force_partials(aux[0, b], aux[1, b], k[b], e[b], c[b], d[b], False)
         aux[2, b] = raw if aux[0, b] > 0.0 else 0.0
         aux[3, b] = vz1[b] - wd  # rate of the gap (= -delta) of a flying ball
     return True

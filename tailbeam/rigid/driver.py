@@ -23,6 +23,7 @@ from tailbeam.errors import WorkLimitError
 from tailbeam.rigid.model import Pair, time_to_contact
 from tailbeam.rigid.result import Impact, RigidResult
 from tailbeam.rigid.trajectory import TrajectoryBuilder
+from tailbeam.solvers.records import EventKind
 
 
 @dataclass
@@ -122,7 +123,7 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
             f"t = {tc:.6g} s; raise max_contacts, or rest_speed (now {p.rest_speed} m/s) to "
             "declare slow bounces at rest sooner"
         )
-    st.events.append((tc, p.name, "contact_start"))
+    st.events.append((tc, p.name, EventKind.CONTACT_START))
     if p.e_rest > 0.0 and p.excess_energy(0.0, v_in) <= p.e_rest:
         # Touching with (almost) no energy to spare: at rest at once (rule B at first touch).
         _rest(st, tc, index, v_in, 0.0, tc)
@@ -154,7 +155,7 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
         )
     )
     if at_rest:
-        st.events.append((t_end, p.name, "rest"))
+        st.events.append((t_end, p.name, EventKind.REST))
         st.builder.rest(t_end, p.radius - p.delta_static, p.mass * p.gravity)
         st.rest_time = t_end
         st.done = True
@@ -182,7 +183,7 @@ def _rest(st, tc, index, v_in, v_out, t_end):
             True,
         )
     )
-    st.events.append((t_end, p.name, "rest"))
+    st.events.append((t_end, p.name, EventKind.REST))
     st.builder.rest(t_end, p.radius - p.delta_static, p.mass * p.gravity)
     st.rest_time = t_end
     st.done = True

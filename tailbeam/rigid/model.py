@@ -30,6 +30,7 @@ from tailbeam.bodies import Ball, Plate, check_ball_above_plate
 from tailbeam.contact_law import ImpactLaw
 from tailbeam.errors import InputError, require_nonnegative, require_positive, require_real
 from tailbeam.hertz import static_penetration
+from tailbeam.physics import impact
 
 DEFAULT_REST_SPEED = 0.01  # m/s, see the module docstring
 DEFAULT_MAX_CONTACTS = 20_000  # per ball
@@ -70,8 +71,7 @@ class Pair:
 
     def excess_energy(self, delta: float, u: float) -> float:
         """Mechanical energy in J above the static rest state (see the module docstring)."""
-        dp = max(delta, 0.0)
-        elastic = self.k * dp ** (self.e + 1.0) / (self.e + 1.0)
+        elastic = impact.elastic_energy(delta, self.k, self.e)
         return 0.5 * self.mass * u * u + elastic - self.mass * self.gravity * delta + self.e_trap
 
     def contains(self, plate: Plate, t: float) -> bool:

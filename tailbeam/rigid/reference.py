@@ -16,6 +16,7 @@ from scipy.integrate import solve_ivp
 
 from tailbeam.bodies import STANDARD_GRAVITY
 from tailbeam.errors import WorkLimitError
+from tailbeam.physics import impact
 from tailbeam.rigid import driver
 from tailbeam.rigid.model import (
     DEFAULT_MAX_CONTACTS,
@@ -24,12 +25,13 @@ from tailbeam.rigid.model import (
     check_rtol,
     make_pairs,
 )
+from tailbeam.solvers.records import EventKind
 
 CHUNK = 400.0  # integrate at most this many contact time scales per solve_ivp call
 _SAME_FUNCTION = {
-    "full_damping": ("full_damping",),
-    "clamp_on": ("clamp",),
-    "clamp_off": ("clamp",),
+    EventKind.FULL_DAMPING: ("full_damping",),
+    EventKind.CLAMP_ON: ("clamp",),
+    EventKind.CLAMP_OFF: ("clamp",),
 }
 
 
@@ -81,46 +83,24 @@ class _Contact:
     def __init__(self, p, rtol):
         self.p, self.rtol = p, rtol
 
-    # --- force law of one region (ramp: delta < d; clamped: force held at 0) ---
-    def damping(self, delta, ramp):
-        if not ramp:
-            return self.p.c
-        s = delta / self.p.d
-        return self.p.c * s * s * (3.0 - 2.0 * s)
-
-    def raw(self, delta, u, ramp):
-        if delta <= 0.0:
-            return 0.0
-        return self.p.k * delta**self.p.e + self.damping(delta, ramp) * u
+    # --- the law of one region (ramp: delta < d; clamped: force held at 0), from the core ---
+    def _law(self):
+        p = self.p
+        return p.k, p.e, p.c, p.d
 
     def force(self, delta, u, ramp, clamped):
-        return 0.0 if clamped else self.raw(delta, u, ramp)
+        if clamped or delta <= 0.0:
+            return 0.0
+        return impact.region_force(delta, u, *self._law(), ramp, False)
 
     def clamp_indicator(self, delta, u, ramp):
-        """raw / (k delta^e): same sign as the raw force, but it does not vanish at delta = 0,
-        so the clamp events never coincide with separation. At delta <= 0: its limit at 0+."""
-        p = self.p
-        if delta > 0.0:
-            return 1.0 + self.damping(delta, ramp) * u / (p.k * delta**p.e)
-        if ramp and p.e < 2.0:
-            return 1.0
-        if ramp and p.e == 2.0:
-            return 1.0 + 3.0 * p.c * u / (p.k * p.d * p.d)
-        return -1.0 if u < 0.0 else 1.0
+        """Sign of the unclamped force, not 0 at delta = 0 (``impact.clamp_indicator``)."""
+        return impact.clamp_indicator(delta, u, *self._law(), ramp)
 
     def dforce(self, delta, u, ramp):
         """dF/dt of the unclamped force along the motion."""
-        p = self.p
-        if delta <= 0.0:
-            return 0.0
-        ddamp = 0.0
-        if ramp:
-            s = delta / p.d
-            ddamp = p.c * 6.0 * s * (1.0 - s) / p.d
-        accel = p.gravity - self.raw(delta, u, ramp) / p.mass
-        return (p.k * p.e * delta ** (p.e - 1.0) + ddamp * u) * u + self.damping(
-            delta, ramp
-        ) * accel
+        accel = self.p.gravity - self.force(delta, u, ramp, False) / self.p.mass
+        return impact.region_force_rate(delta, u, accel, *self._law(), ramp)
 
     def run(self, v_in, tau_max, steps_left):
         p = self.p
@@ -183,14 +163,14 @@ class _Contact:
             fresh = hit
             if hit is None:
                 continue
-            if hit == "full_damping":
+            if hit == EventKind.FULL_DAMPING:
                 y[0] = p.d  # exactly on the kink
                 ramp = not ramp
-                events.append((tau, "full_damping"))
-            elif hit in ("clamp_on", "clamp_off"):
-                clamped = hit == "clamp_on"
                 events.append((tau, hit))
-            elif hit == "contact_end":
+            elif hit in (EventKind.CLAMP_ON, EventKind.CLAMP_OFF):
+                clamped = hit == EventKind.CLAMP_ON
+                events.append((tau, hit))
+            elif hit == EventKind.CONTACT_END:
                 # Past delta = 0 the force is 0, so the step holding the root straddles a kink:
                 # integrate its part up to the root again, on its own, for the exit state.
                 if len(sol.t) >= 2 and sol.t[-2] < tau:
@@ -203,10 +183,10 @@ class _Contact:
                     for j, interp in enumerate(redo.sol.interpolants):
                         piece = (redo.sol.ts[j], interp.t_old, interp.h, interp.y_old.copy())
                         pieces.append((*piece, interp.F))
-                events.append((tau, "contact_end"))
+                events.append((tau, hit))
                 status, v_out = "separated", -y[1]
                 break
-            elif hit == "rest":
+            elif hit == EventKind.REST:
                 status, v_out = "rest", 0.0
                 break
         tau_start, tau_old, step, y_old, coef = (np.array(x) for x in zip(*pieces, strict=True))
@@ -244,10 +224,10 @@ class _Contact:
         evs = [
             (
                 mk(lambda t, s: s[0] - p.d, True, 1 if ramp else -1, "full_damping"),
-                "full_damping",
+                EventKind.FULL_DAMPING,
                 "switch",
             ),
-            (mk(lambda t, s: s[0], True, -1), "contact_end", "switch"),
+            (mk(lambda t, s: s[0], True, -1), EventKind.CONTACT_END, "switch"),
             (mk(lambda t, s: s[1], False, -1), None, "pen"),
         ]
         if p.clamp and p.c > 0.0:
@@ -259,7 +239,7 @@ class _Contact:
                         1 if clamped else -1,
                         "clamp",
                     ),
-                    "clamp_off" if clamped else "clamp_on",
+                    EventKind.CLAMP_OFF if clamped else EventKind.CLAMP_ON,
                     "switch",
                 )
             )
@@ -269,7 +249,7 @@ class _Contact:
             evs.append(
                 (
                     mk(lambda t, s: p.excess_energy(s[0], s[1]) - p.e_rest, True, -1),
-                    "rest",
+                    EventKind.REST,
                     "switch",
                 )
             )

@@ -1,15 +1,17 @@
-"""Pieces of the compiled contact kernel: the force law of one region of the IMPACT law, the
-watched (event) functions, DOP853 dense-output evaluation and bracketed root finding.
+"""Pieces of the compiled contact kernel: the right-hand side in one region of the IMPACT law
+(the law itself: ``tailbeam.physics.impact``), the watched (event) functions, DOP853
+dense-output evaluation and bracketed root finding.
 
 A region is (ramp, clamped): ramp means delta < d (STEP's cubic), clamped means Adams' max(0, .)
 holds the force at 0. Each region's formula is smooth and is used past the region's border
 too, so integration steps never straddle a kink (see kernel.py).
 """
 
-import math
-
 import numpy as np
 from numba import njit
+
+from tailbeam.physics import impact
+from tailbeam.solvers.records import EventKind
 
 # parameter vector layout
 P_M, P_G, P_K, P_E, P_C, P_D, P_CLAMP, P_EREST, P_ETRAP = range(9)
@@ -19,7 +21,8 @@ W_FULL, W_CLAMP, W_SEP, W_REST, W_UMAX, W_PEAK = range(6)
 N_WATCH = 6
 # event codes written to the event buffer
 EV_FULL, EV_CLAMP_ON, EV_CLAMP_OFF, EV_END, EV_REST = range(5)
-EVENT_NAMES = ("full_damping", "clamp_on", "clamp_off", "contact_end", "rest")
+EVENT_NAMES = (EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF,
+               EventKind.CONTACT_END, EventKind.REST)  # fmt: skip
 # return status
 ST_SEPARATED, ST_REST, ST_DURATION, ST_STEP_LIMIT, ST_BUFFER_FULL, ST_STEP_TINY = range(6)
 
@@ -29,27 +32,12 @@ INTERIOR = (0.25, 0.5, 0.75)
 
 
 @njit(cache=True)
-def _pow(x, e):
-    """x^e for x > 0; the Hertz exponent 3/2 as x sqrt(x) (several times cheaper)."""
-    if e == 1.5:
-        return x * math.sqrt(x)
-    return x**e
-
-
-@njit(cache=True)
-def _damping(delta, ramp, par):
-    if not ramp:
-        return par[P_C]
-    s = delta / par[P_D]
-    return par[P_C] * s * s * (3.0 - 2.0 * s)
-
-
-@njit(cache=True)
 def accel(delta, u, ramp, clamped, par):
     """du/dt = g - F / m in the region (ramp, clamped)."""
     if clamped or delta <= 0.0:
         return par[P_G]
-    return par[P_G] - (par[P_K] * _pow(delta, par[P_E]) + _damping(delta, ramp, par) * u) / par[P_M]
+    k, e, c, d = par[P_K], par[P_E], par[P_C], par[P_D]
+    return par[P_G] - impact.region_force(delta, u, k, e, c, d, ramp, False) / par[P_M]
 
 
 @njit(cache=True)
@@ -59,25 +47,10 @@ def watch_all(delta, u, ramp, clamped, par, out):
     out[W_FULL] = delta - d
     out[W_SEP] = delta
     out[W_UMAX] = u
-    damp = _damping(delta, ramp, par)
-    if delta > 0.0:
-        pe = _pow(delta, e)
-        raw = k * pe + damp * u
-        out[W_CLAMP] = 1.0 + damp * u / (k * pe)
-        elastic = k * pe * delta / (e + 1.0)
-        ddamp = c * 6.0 * (delta / d) * (1.0 - delta / d) / d if ramp else 0.0
-        accel = g - raw / m
-        out[W_PEAK] = (k * e * pe / delta + ddamp * u) * u + damp * accel
-    else:
-        raw = 0.0
-        elastic = 0.0
-        if ramp and e < 2.0:
-            out[W_CLAMP] = 1.0
-        elif ramp and e == 2.0:
-            out[W_CLAMP] = 1.0 + 3.0 * c * u / (k * d * d)
-        else:
-            out[W_CLAMP] = -1.0 if u < 0.0 else 1.0
-        out[W_PEAK] = 0.0
+    raw = impact.region_force(delta, u, k, e, c, d, ramp, False) if delta > 0.0 else 0.0
+    out[W_CLAMP] = impact.clamp_indicator(delta, u, k, e, c, d, ramp)
+    out[W_PEAK] = impact.region_force_rate(delta, u, g - raw / m, k, e, c, d, ramp)
+    elastic = impact.elastic_energy(delta, k, e)
     out[W_REST] = 0.5 * m * u * u + elastic - m * g * delta + par[P_ETRAP] - par[P_EREST]
     if clamped:
         return 0.0

@@ -10,8 +10,10 @@ how it ended.
 from dataclasses import dataclass, field
 
 from tailbeam.result import BallsResult
+from tailbeam.solvers.records import EventKind
 
-EVENT_KINDS = ("contact_start", "full_damping", "clamp_on", "clamp_off", "contact_end", "rest")
+EVENT_KINDS = (EventKind.CONTACT_START, EventKind.FULL_DAMPING, EventKind.CLAMP_ON,
+               EventKind.CLAMP_OFF, EventKind.CONTACT_END, EventKind.REST)  # fmt: skip
 
 
 @dataclass(frozen=True)

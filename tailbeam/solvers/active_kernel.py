@@ -62,6 +62,7 @@ from tailbeam.solvers.cheb_events import (
     interpolant_max,
 )
 from tailbeam.solvers.jit import helper_njit
+from tailbeam.solvers.records import EventKind
 
 # return status of ``advance``
 ST_STOP, ST_START, ST_END, ST_LEAVE, ST_SETTLE, ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = range(8)
@@ -71,7 +72,7 @@ STATUS_NAMES = (
 )  # fmt: skip
 # kinds in the event log
 LOG_FULL, LOG_CLAMP_ON, LOG_CLAMP_OFF = range(3)
-LOG_NAMES = ("full_damping", "clamp_on", "clamp_off")
+LOG_NAMES = (EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF)
 # integer outputs (iout)
 IO_STATUS, IO_INDEX, IO_EDGE, IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_ROWS, IO_LOG = range(8)
 

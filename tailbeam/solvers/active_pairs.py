@@ -25,9 +25,9 @@ there); the full-damping and clamp rows use delta and F.
 
 ``law`` (P, 6) columns: stiffness k (N/m^e), exponent e, damping c (N s/m), penetration d (m),
 clamp (0/1), residual compliance C (m/N, plate pairs; 0 otherwise), built by
-``contact_law.ball_ball_law`` / ``ball_plate_law``. ``region_force``
-and ``clamp_indicator`` are the numba twins of ``contact_law.impact_force_in_region`` and
-``contact_law.clamp_indicator`` (tests/test_contact_law_regions.py checks them).
+``contact_law.ball_ball_law`` / ``ball_plate_law``. The law itself (``region_force``,
+``clamp_indicator``, ``elastic_energy``, ``elastic_stiffness``, the damping slope) is
+``tailbeam.physics.impact``'s, the one definition every solver uses.
 
 Watched functions ("rows"), as in ``stream_reference._Reference.rows``: value g = sign x f +
 band, its event where g becomes negative:
@@ -43,6 +43,15 @@ grazing touch does not start and end contacts over and over at round-off level.
 
 import math
 
+from tailbeam.physics.impact import (
+    clamp_indicator,
+    elastic_energy,
+    elastic_stiffness,
+    region_force,
+)
+from tailbeam.physics.impact import power as _pow  # noqa: F401  (the names callers use)
+from tailbeam.physics.impact import region_damping as damping_in_region  # noqa: F401
+from tailbeam.physics.impact import region_damping_slope as damping_slope
 from tailbeam.solvers.jit import helper_njit
 
 L_K, L_E, L_C, L_D, L_CLAMP, L_CRES = range(6)
@@ -53,71 +62,7 @@ CLAMP_BAND = 1e-10
 EDGE_BAND = 1e-13
 
 
-@helper_njit
-def _pow(x, e):
-    """x^e for x >= 0; the Hertz exponent 3/2 as x sqrt(x)."""
-    if e == 1.5:
-        return x * math.sqrt(x)
-    return x**e
-
-
-@helper_njit
-def damping_in_region(delta, c, d, ramp):
-    """c STEP(delta, 0, 0, d, c) extended past [0, d] (ramp) or c (full damping), N s/m."""
-    if not ramp:
-        return c
-    s = delta / d
-    return c * s * s * (3.0 - 2.0 * s)
-
-
-@helper_njit
-def region_force(delta, rate, k, e, c, d, ramp, clamped):
-    """Force in N of one region's smooth formula (twin of impact_force_in_region)."""
-    if clamped:
-        return 0.0
-    pos = delta if delta > 0.0 else 0.0
-    return k * _pow(pos, e) + damping_in_region(pos, c, d, ramp) * rate
-
-
-@helper_njit
-def clamp_indicator(delta, rate, k, e, c, d, ramp):
-    """Raw force / (k delta^e) (twin of contact_law.clamp_indicator)."""
-    if delta > 0.0:
-        return 1.0 + damping_in_region(delta, c, d, ramp) * rate / (k * _pow(delta, e))
-    if ramp and e < 2.0:
-        return 1.0
-    if ramp and e == 2.0:
-        return 1.0 + 3.0 * c * rate / (k * d * d)
-    return -1.0 if rate < 0.0 else 1.0
-
-
-@helper_njit
-def elastic_energy(delta, k, e):
-    """k delta^(e+1) / (e+1) in J for delta > 0, else 0."""
-    if delta <= 0.0:
-        return 0.0
-    return k * _pow(delta, e) * delta / (e + 1.0)
-
-
 # --- residual flexibility at plate contacts: the law's call sites with a spring in series ---
-
-
-@helper_njit
-def elastic_stiffness(delta, k, e):
-    """d(k delta^e)/d delta = k e delta^(e-1) in N/m for delta > 0, else 0."""
-    if delta <= 0.0:
-        return 0.0
-    return k * e * _pow(delta, e) / delta
-
-
-@helper_njit
-def damping_slope(delta, c, d, ramp):
-    """d/d delta of ``damping_in_region`` (N s/m^2): 6 c s (1 - s) / d in the ramp, s = delta/d;
-    0 at full damping."""
-    if not ramp:
-        return 0.0
-    s = delta / d
-    return 6.0 * c * s * (1.0 - s) / d
 
 
 @helper_njit

@@ -1,7 +1,8 @@
-"""What a stream solver reports: event kinds, contact (impact) records and leave events.
+"""What the solvers report: event kinds, contact (impact) records and leave events.
 
-Written once here so the fast stream solver and the slow reference report the same shape
-(the refactor of issue 7 extends this to every solver).
+``EventKind`` is the one table of event kinds of every solver (rigid, coupled, stream, and
+their references); ``ContactRecord`` and ``LeaveEvent`` are the stream solvers' records (the
+refactor of issue 7 extends them to every solver).
 """
 
 from dataclasses import asdict, dataclass
@@ -11,7 +12,8 @@ PLATE = "plate"  # the partner name of a ball-plate contact
 
 
 class EventKind(str, Enum):
-    """Kinks and changes a solver stops at (the value is what the outputs write)."""
+    """Kinks and changes a solver stops at. A member equals its value (``EventKind.REST ==
+    "rest"``) and prints as it (``str``, f-strings): the value is what the outputs write."""
 
     CONTACT_START = "contact_start"
     CONTACT_END = "contact_end"
@@ -20,6 +22,13 @@ class EventKind(str, Enum):
     CLAMP_OFF = "clamp_off"
     LEAVE = "leave"  # a ball's centre passed an edge of the plate
     RELEASE = "release"  # a ball entered the scene (a stream particle's release time)
+    REST = "rest"  # a ball came to rest on the plate (rigid and coupled solvers' rest rules)
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)
 
 
 @dataclass

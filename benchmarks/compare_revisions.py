@@ -1,0 +1,183 @@
+"""How far every solver's results moved from another revision's (a refactor's check).
+
+    python benchmarks/compare_revisions.py --base REV [--quick]
+
+Runs one scene per solver in this working tree and in ``git archive REV`` (each with its own
+numba cache, single-threaded) and compares every number they report: the rigid solver and
+its scipy reference (paper section 4.1: coal balls at 1 and 2 m/s, c = 800 N s/m, 1 s), the
+two-way coupled modal solver (sandstone at 2 m/s on the closed-form SSSS plate, 5 kHz band,
+c = 800 N s/m, residual flexibility on) and the FE reference (the same ball on Argyris 8x8,
+dt 2e-7 s, 0.4 ms), the stream solver and the stream reference (the ten-ball scene on a 15 deg
+plate, c = 2000 N s/m, d = 2e-5 m: ball-ball contacts, clamp and STEP kinks), the stream
+solver on the modal plate. Prints per solver "bit-identical" or the largest difference of
+any number relative to the largest magnitude of its column (and the column), the numeric
+columns whose length changed (an adaptive reference taking other steps), and the non-numeric
+columns (names, event kinds, ends) that differ. ``--quick`` drops the FE reference and the
+stream reference (the slow ones). Exit code 1 if a non-numeric column differs; how large a
+numeric difference is acceptable is the reader's call: the adaptive references take other
+steps after a 1-ulp change of the force, and a 1-ulp change of the stiffness alone moves the
+FE reference's sensor acceleration by 2.4e-6 of its peak (measured on this scene). The
+active set's own bitwise check is ``compare_active_set_revisions.py``. ``--keep DIR`` keeps
+the results there and reuses DIR/old.pkl if present (the base is then not run again).
+"""
+
+import argparse
+import dataclasses
+import enum
+import pickle
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from compare_active_set_revisions import extract_revision
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _columns(obj, prefix, out):
+    """Flatten records, tuples, dicts and arrays into named columns (lists of scalars)."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        obj = {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
+    if isinstance(obj, dict):
+        for key, value in obj.items():
+            _columns(value, f"{prefix}.{key}", out)
+    elif isinstance(obj, list | tuple):
+        for i, value in enumerate(obj):
+            _columns(value, f"{prefix}[{i}]" if len(obj) < 8 else f"{prefix}[]", out)
+    elif isinstance(obj, np.ndarray):
+        out.setdefault(prefix, []).extend(np.ravel(obj).tolist())
+    elif isinstance(obj, enum.Enum):
+        out.setdefault(prefix, []).append(str(obj.value))
+    else:
+        out.setdefault(prefix, []).append(obj)
+
+
+def run_solvers(out_path, quick):
+    """Run the scenes with the tailbeam on sys.path; pickle their flattened results."""
+    import stream_scenes
+
+    import tailbeam
+    from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_plate_law
+    from tailbeam.coupled import simulate_coupled
+    from tailbeam.modal import ssss_kirchhoff_basis
+    from tailbeam.physics.incline import InclinedPlate
+    from tailbeam.rigid import simulate_rigid
+    from tailbeam.rigid.reference import simulate_rigid_reference
+    from tailbeam.solvers.stream import solve_stream
+    from tailbeam.solvers.stream_plate import StreamPlate
+    from tailbeam.solvers.stream_reference import simulate_stream_reference
+    from tailbeam.streams.generator import Particle
+
+    print(f"running {tailbeam.__file__}", flush=True)
+    law = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0, penetration=1e-4)
+    balls = [Ball("A", COAL, 0.03, (-0.1, 0.0, 0.13), (0.0, 0.0, -1.0)),
+             Ball("B", COAL, 0.03, (0.1, 0.0, 0.13), (0.0, 0.0, -2.0))]  # fmt: skip
+    runs = {}
+    rigid = simulate_rigid(balls, Plate(), [law, law], 1.0, rtol=1e-11)
+    grid = rigid.time_grid(5120.0)
+    runs["rigid"] = (rigid.impacts, rigid.events, rigid.sample(grid))
+    ref = simulate_rigid_reference(balls, Plate(), [law, law], 1.0)
+    runs["rigid reference"] = (ref.impacts, ref.events, ref.sample(grid))
+
+    basis = ssss_kirchhoff_basis(Plate(), 5000.0)
+    ball = Ball("s", SANDSTONE, 0.03, (0.07, -0.05, 0.03 + 1e-4), (0.0, 0.0, -2.0))
+    slaw = ball_plate_law(SANDSTONE, 0.03, CARBON_STEEL, damping=800.0)
+    coupled = simulate_coupled([ball], basis, [slaw], 2e-3, gravity=9.80665)
+    runs["coupled"] = (coupled.impacts, coupled.events, coupled.nodes)
+    if not quick:
+        from tailbeam.coupled.fe_reference import fe_reference
+        from tailbeam.plate import assemble_plate
+
+        model = assemble_plate(Plate(), "SSSS", theory="kirchhoff", divisions=8)
+        fe = fe_reference(model, ball, slaw, 4e-4, dt=2e-7, sensors=[(0.05, 0.10)])
+        runs["FE reference"] = (fe.impacts, fe.t, fe.sensor_a)
+
+    incline = InclinedPlate(inclination=15.0)
+    ten = stream_scenes.ten_ball_scene(incline)
+    parts = [Particle(b.name, "", "coal", b.material, b.radius, b.mass, 0.0,
+                      tuple(b.position), tuple(b.velocity)) for b in ten]  # fmt: skip
+    opts = dict(damping=2000.0, penetration=2e-5)
+    fast = solve_stream(parts, incline, 0.1, rtol=1e-12, rest_speed=0.0, progress=False, **opts)
+    runs["stream"] = (fast.contacts, fast.leaves, fast.events)
+    if not quick:
+        sref = simulate_stream_reference(ten, incline, 0.1, **opts)
+        runs["stream reference"] = (sref.contacts, sref.leaves, sref.events, sref.energy)
+    plate = StreamPlate(basis, np.full(basis.n_modes, 0.01))
+    one = [Particle("s", "", "gangue", SANDSTONE, 0.03, ball.mass, 0.0, tuple(ball.position),
+                    tuple(ball.velocity))]  # fmt: skip
+    modal = solve_stream(one, InclinedPlate(), 2e-3, damping=800.0, rtol=1e-12, progress=False,
+                         plate=plate)  # fmt: skip
+    runs["stream, modal plate"] = (modal.contacts, modal.events)
+    flat = {}
+    for name, result in runs.items():
+        flat[name] = {}
+        _columns(result, "", flat[name])
+    Path(out_path).write_bytes(pickle.dumps(flat))
+
+
+def _run_in(tree, out_path, cache, quick):
+    code = (f"import sys; sys.path[:0] = [{str(tree)!r}, {str(tree / 'tests')!r}, "
+            f"{str(ROOT / 'benchmarks')!r}]; import compare_revisions as c; "
+            f"c.run_solvers({str(out_path)!r}, {quick!r})")  # fmt: skip
+    env = {"TAILBEAM_CACHE_DIR": str(cache), "NUMBA_CACHE_DIR": str(cache / "numba"),
+           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+           "PATH": "/usr/bin:/bin"}  # fmt: skip
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=tree, env=env)
+
+
+def compare(a: dict, b: dict) -> tuple:
+    """(bit-identical, differing non-numeric columns, numeric columns of another length,
+    largest relative difference and its column) of one solver's flattened results."""
+    text, lengths = sorted(a.keys() ^ b.keys()), []
+    worst, where, identical = 0.0, "", True
+    for key in sorted(a.keys() & b.keys()):
+        x, y = a[key], b[key]
+        numeric = all(isinstance(v, float | int) and not isinstance(v, bool) for v in x + y)
+        if numeric and len(x) != len(y):
+            lengths.append(f"{key}: {len(x)} vs {len(y)} values")
+            continue
+        if not numeric:
+            if x != y:
+                text.append(key)
+            continue
+        x, y = np.array(x, dtype=float), np.array(y, dtype=float)
+        identical &= np.array_equal(x, y, equal_nan=True)
+        scale = np.nanmax(np.abs(x)) if np.any(np.isfinite(x)) else 1.0
+        diff = np.abs(x - y)[~(np.isnan(x) & np.isnan(y))]
+        if diff.size and scale > 0.0 and float(np.max(diff)) / scale > worst:
+            worst, where = float(np.max(diff)) / scale, key
+    return identical and not text and not lengths, text, lengths, worst, where
+
+
+def main(base, quick=False, keep=None):
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        store = Path(keep).resolve() if keep else tmp
+        store.mkdir(parents=True, exist_ok=True)
+        if not (store / "old.pkl").exists():
+            _run_in(extract_revision(base, tmp), store / "old.pkl", tmp / "cache-base", quick)
+        _run_in(ROOT, store / "new.pkl", tmp / "cache-new", quick)
+        a = pickle.loads((store / "old.pkl").read_bytes())
+        b = pickle.loads((store / "new.pkl").read_bytes())
+    ok = True
+    for name in a:
+        identical, text, lengths, worst, where = compare(a[name], b[name])
+        ok &= not text
+        n = sum(len(v) for v in a[name].values())
+        what = (
+            "bit-identical" if identical else f"largest relative difference {worst:.1e} ({where})"
+        )
+        notes = [f"DIFFERENT: {', '.join(text)}"] * bool(text) + lengths
+        print(f"{name}: {what} ({n} values)" + "".join(f"; {x}" for x in notes))
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--base", required=True, help="git revision to compare with")
+    parser.add_argument("--quick", action="store_true", help="without the slow references")
+    parser.add_argument("--keep", help="folder for the results (old.pkl there: base not rerun)")
+    args = parser.parse_args()
+    sys.exit(main(args.base, args.quick, args.keep))
