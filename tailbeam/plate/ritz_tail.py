@@ -74,21 +74,22 @@ def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> M
 
     points: (p, 2) m, where the loads act (the contact points, known in advance);
     contact_radius: m, the load is 1 N spread over a disc of this radius (0: a point load;
-    use ``tailbeam.contact_patch.load_radius`` as the solver does). The pseudo-modes have
+    use ``tailbeam.contact_patch.load_radius`` as the solver does), one for every point or
+    a sequence of p, one per point (balls of different sizes). The pseudo-modes have
     their true shapes (seen at sensors and other points), and the residual compliance of the
     returned basis (static minus every mode it holds) is ~0 at the points. Raises InputError
     for bad input, WorkLimitError if k x points exceeds MAX_RITZ_VECTORS.
     """
     _check_basis(basis)
     _check_count("k", k, 1)
-    radius = require_nonnegative("contact_radius", contact_radius)
     pts = check_points(basis.plate, points)
+    radii = _radii(contact_radius, len(pts))
     if k * len(pts) > MAX_RITZ_VECTORS:
         raise WorkLimitError(
             f"{k} Ritz vectors x {len(pts)} points > {MAX_RITZ_VECTORS}; lower k or the points"
         )
     model = basis.fe_model()
-    loads = np.column_stack([model.load_vector(p, radius) for p in pts])
+    loads = np.column_stack([model.load_vector(p, r) for p, r in zip(pts, radii, strict=True)])
     omega, Z = ritz_tail_modes(basis, loads, int(k))
     parent = basis.deflection_at
 
@@ -107,6 +108,14 @@ def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> M
         basis.static_deflection_at,
         info,
     )
+
+
+def _radii(contact_radius, n: int) -> list:
+    """n load radii (m) from one radius or a sequence of n, else InputError."""
+    radii = np.asarray(contact_radius, dtype=float).ravel()
+    if radii.size not in (1, n):
+        raise InputError("contact_radius", f"must be one radius or {n}, one per point")
+    return [require_nonnegative("contact_radius", float(r)) for r in np.resize(radii, n)]
 
 
 def _check_basis(basis):
