@@ -78,7 +78,7 @@ class ModalPlateSettings:
     coupling: "two-way" or "one-way" (rigid-plate forces applied to the plate).
     tail: how the truncated modes act at a contact: "quasi-static" (their static compliance)
     or "ritz" (load-dependent Ritz pseudo-modes at the balls' first contact points,
-    tailbeam.coupled.ritz_tail; needs residual_flexibility and two-way coupling).
+    tailbeam.coupled.ritz_prepass; needs residual_flexibility and two-way coupling).
     tail_modes: Ritz pseudo-modes per contact point, "auto" (chosen per point) or a whole
     number >= 1.
     """

@@ -244,12 +244,12 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
     if not isinstance(scene, Scene):
         raise InputError("scene", "must be a tailbeam.scene.Scene")
     settings = scene.modal or ModalPlateSettings()
+    check_tail_scene(scene)  # before the basis is built
     band = choose_band(scene, settings)
     if basis is None:
         basis = build_basis(scene, band, use_cache=use_cache)
     tail = None
     if settings.tail == "ritz":
-        check_tail_scene(scene)
         basis, tail = ritz_tail_basis(scene, basis, settings.tail_modes)
     choices = _choices(band, basis)
     if tail is not None:

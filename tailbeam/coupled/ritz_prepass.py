@@ -136,11 +136,7 @@ def ritz_tail_basis(scene, basis, tail_modes="auto"):
         info["k_change_per_point"] = [float(ch) for _, ch in chosen]
     else:
         k = int(tail_modes)
-    if k * len(points) > MAX_RITZ_VECTORS:
-        raise WorkLimitError(
-            f"plate.tail_modes: {k} Ritz modes x {len(points)} contact points > "
-            f"{MAX_RITZ_VECTORS}; lower plate.tail_modes or use fewer balls"
-        )
+    _check_work(k, len(points))
     xy = [c["point"] for c in points]
     radii = [c["radius"] for c in points]
     with task(f"Ritz tail: {k} x {len(points)} pseudo-modes"):
@@ -164,10 +160,25 @@ def describe_tail(info: dict) -> str:
 
 
 def check_tail_scene(scene) -> None:
-    """InputError naming plate.tail for scenes "ritz" cannot run (the stream solver)."""
-    if scene.modal is not None and scene.modal.tail == "ritz" and scene.needs_stream_solver:
+    """Before any work: InputError naming plate.tail for scenes "ritz" cannot run (the stream
+    solver's), WorkLimitError naming plate.tail_modes if a set k x the first-contact points
+    exceeds MAX_RITZ_VECTORS."""
+    settings = scene.modal
+    if settings is None or settings.tail != "ritz":
+        return
+    if scene.needs_stream_solver:
         raise InputError(
             "plate.tail",
             "'ritz' is for the coupled modal solver; this scene runs on the stream solver "
             "(streams, an inclined plate or balls that may touch); use 'quasi-static'",
+        )
+    if settings.tail_modes != "auto":
+        _check_work(settings.tail_modes, len(_unique(first_contacts(scene, "kirchhoff"))))
+
+
+def _check_work(k: int, n_points: int) -> None:
+    if k * n_points > MAX_RITZ_VECTORS:
+        raise WorkLimitError(
+            f"plate.tail_modes: {k} Ritz modes x {n_points} contact points > "
+            f"{MAX_RITZ_VECTORS}; lower plate.tail_modes or use fewer balls"
         )
