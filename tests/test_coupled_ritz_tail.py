@@ -6,7 +6,7 @@ import math
 
 import pytest
 from test_cli import tailbeam
-from test_coupled_fe import IMPACT, MESHES, R, SENSOR, _basis, runs  # noqa: F401 (fixture)
+from test_coupled_fe import IMPACT, MESHES, SENSOR, R, _basis, runs  # noqa: F401 (fixture)
 
 import tailbeam as tb
 from tailbeam.bodies import Ball, Plate
