@@ -25,16 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
-
-from tailbeam.bodies import Ball, Plate  # noqa: E402
-from tailbeam.coupled.auto import build_basis, choose_band, simulate_scene_modal  # noqa: E402
-from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities, in_band  # noqa: E402
-from tailbeam.coupled.fe_reference import relative_l2  # noqa: E402
-from tailbeam.materials import SANDSTONE  # noqa: E402
-from tailbeam.progress import quiet  # noqa: E402
-from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene  # noqa: E402
-from tailbeam.scene_file import load_scene  # noqa: E402
+from tailbeam.bodies import Ball, Plate
+from tailbeam.coupled.auto import build_basis, choose_band, simulate_scene_modal
+from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities, in_band, relative_l2
+from tailbeam.materials import SANDSTONE
+from tailbeam.progress import quiet
+from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
+from tailbeam.scene_file import load_scene
 
 ROOT = Path(__file__).parents[1]
 TAILS = ("quasi-static", "ritz")
@@ -83,6 +80,7 @@ def _sensor_error(res, t, a_ref, point, band_hz):
 
 
 def case_test():
+    sys.path.insert(0, str(ROOT / "tests"))
     from test_coupled_fe import _basis, _case
 
     case = _case("kirchhoff")
@@ -117,8 +115,15 @@ def case_default():
 
 def case_sweep():
     base = load_scene(ROOT / "examples" / "single_impact_base.toml")
-    base = Scene(base.balls, base.plate, base.contact, duration=base.duration, plate_model="modal",
-                 modal=base.modal, gravity=base.gravity)  # fmt: skip (no noisy sensor)
+    base = Scene(
+        base.balls,
+        base.plate,
+        base.contact,
+        duration=base.duration,
+        plate_model="modal",
+        modal=base.modal,
+        gravity=base.gravity,
+    )  # fmt: skip (no noisy sensor)
     point = (0.1, 0.15)
     truth_scene = _with_tail(base, "ritz", fmax_hz=40000.0)
     basis = build_basis(base, choose_band(base))

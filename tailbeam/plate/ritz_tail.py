@@ -14,8 +14,9 @@ ordinary extra modes (Rayleigh damping stays diagonal) with true plate shapes.
 Measured (docs/fe-convergence.md, "Many-node tails"): at a 20 kHz band, k = 16-32 per contact
 point brings the contact quantities of the test meshes to 2-7e-6 of the full FE solution
 (quasi-static residual 3.5e-5), k = 48-128 on the default Argyris 23x23 mesh. This module only
-builds them for load points known in advance (``with_ritz_tail``: one falling ball, the FE
-cross-checks); the coupled solver does not create them per contact.
+builds them for load points known in advance (``with_ritz_tail``: the FE cross-checks, and
+the coupled solver's pre-pass over the balls' first contact points with ``plate.tail =
+"ritz"``, tailbeam.coupled.ritz_prepass).
 """
 
 import numpy as np
