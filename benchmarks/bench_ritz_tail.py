@@ -3,7 +3,8 @@ the same run, through the scene path (``simulate_scene_modal``, default 200 step
 
     python benchmarks/bench_ritz_tail.py [--out DIR] [--cases test default sweep]
 
-Cases (each run with tail = "quasi-static" and "ritz", tail_modes auto):
+Cases (each run with tail = "quasi-static" and "ritz", tail_modes auto; default and sweep
+also with tail_modes = 32 and 64, which skip the choice of k):
 - test: the FE test case of tests/test_coupled_fe.py (Argyris 8x8, 20 kHz, sandstone 30 mm at
   1 m/s, no damping, 0.6 ms); truth: the full-FE reference (Newmark, 1e-7 s, ~7 s).
 - default: the same impact on the default Argyris 23x23 mesh (4805 DOFs) at 20 kHz; cost only
@@ -35,6 +36,12 @@ from tailbeam.scene_file import load_scene
 
 ROOT = Path(__file__).parents[1]
 TAILS = ("quasi-static", "ritz")
+FIXED_K = (32, 64)  # also run with plate.tail_modes set (no choose_ritz_k) on default/sweep
+
+
+def _variants():
+    """(tail, extra ModalPlateSettings) of the compared runs: the baseline, auto, fixed k."""
+    return [("quasi-static", {}), ("ritz", {})] + [("ritz", {"tail_modes": k}) for k in FIXED_K]
 
 
 def _with_tail(scene, tail, **modal):
@@ -107,8 +114,8 @@ def case_default():
     print(f"default basis: {basis.info.get('divisions')} divisions, {basis.n_modes} modes, "
           f"{time.perf_counter() - t0:.1f} s (cache {basis.info.get('cache')})")  # fmt: skip
     rows = []
-    for tail in TAILS:
-        res, run_s, build_s = _run(_with_tail(scene, tail), basis)
+    for tail, extra in _variants():
+        res, run_s, build_s = _run(_with_tail(scene, tail, **extra), basis)
         rows.append(_row("default (23x23, 20 kHz)", tail, res, basis, run_s, build_s, {}))
     return rows
 
@@ -139,8 +146,8 @@ def case_sweep():
     print(f"sweep truth: {truth_basis.n_modes} modes at 40 kHz ({basis.theory}, {divisions} "
           f"divisions); 40 kHz quasi-static vs ritz: {uncertainty:.1e}")  # fmt: skip
     rows = []
-    for tail in TAILS:
-        res, run_s, build_s = _run(_with_tail(base, tail), basis)
+    for tail, extra in _variants():
+        res, run_s, build_s = _run(_with_tail(base, tail, **extra), basis)
         err = _contact_errors(res, q_ref)
         err["sensor"] = _sensor_error(res, t, a_ref, point, 5000.0)
         rows.append(_row("sweep base (5 kHz, 25 ms)", tail, res, basis, run_s, build_s, err))
@@ -149,6 +156,8 @@ def case_sweep():
 
 def _row(case, tail, res, basis, run_s, build_s, err):
     info = res.info.get("tail", {})
+    if info.get("tail_modes", "auto") != "auto":
+        tail = f"{tail}, tail_modes = {info['tail_modes']}"
     return {"case": case, "tail": tail, "k": info.get("k", "-"),
             "modes": res.basis.n_modes, "prepass_s": build_s, "run_s": run_s,
             "contact": err.get("contact"), "sensor": err.get("sensor")}  # fmt: skip
