@@ -181,12 +181,17 @@ def plot(rows, out: Path):
         for j, (col, what) in enumerate(((4, "contact (max of 4 quantities)"),
                                          (5, "sensor, 0-10 kHz, first 3 ms"))):  # fmt: skip
             ax = axes[i, j]
-            for variant, style in styles.items():
+            for c, (variant, style) in enumerate(styles.items()):
                 if j == 0 and variant == VARIANTS[3]:
                     continue  # the sensor correction does not change the contact
                 sel = [r for r in rows if r[0] == theory and r[3] == variant]
-                ax.loglog([r[1] / 1000 for r in sel], [r[col] for r in sel], style,
-                          label=variant)  # fmt: skip
+                ax.loglog(
+                    [r[1] / 1000 for r in sel],
+                    [r[col] for r in sel],
+                    style,
+                    color=f"C{c}",
+                    label=variant,
+                )  # fmt: skip (one colour per variant)
             if j == 0:
                 ax.axhline(2e-5, color="grey", lw=0.8)
                 ax.text(10.2, 2.2e-5, "2e-5", color="grey", fontsize=8)
