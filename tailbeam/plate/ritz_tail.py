@@ -28,6 +28,7 @@ from tailbeam.plate.model import check_points
 
 MAX_RITZ_VECTORS = 1024  # k x points: memory n_dofs x this x 8 B (250 MB at 30 000 DOFs)
 K_START = 16  # choose_ritz_k's first k (fewer ring coherently: docs/fe-convergence.md)
+DEFLECTION_MEMO = 32  # point sets whose deflections with_ritz_tail's basis keeps
 BREAKDOWN = 1e-10  # a new Krylov vector this small against its start is dropped (exhausted)
 
 
@@ -92,11 +93,19 @@ def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> M
     model = basis.fe_model()
     loads = np.column_stack([model.load_vector(p, r) for p, r in zip(pts, radii, strict=True)])
     omega, Z = ritz_tail_modes(basis, loads, int(k))
-    parent = basis.deflection_at
+    kept, seen = basis.mode_vectors, {}
 
     def deflection_at(at):
-        extra = model.deflection_operator(np.atleast_2d(at)) @ Z
-        return np.column_stack([np.asarray(parent(at)), extra])
+        # one mesh search for the kept and the Ritz modes, memoised: the solver asks again
+        # for the same contact or sensor points (each search ~10 ms on the 23x23 mesh)
+        at = np.atleast_2d(np.asarray(at, dtype=float))
+        key = at.tobytes()
+        if key not in seen:
+            if len(seen) >= DEFLECTION_MEMO:
+                seen.pop(next(iter(seen)))
+            op = model.deflection_operator(at)
+            seen[key] = np.column_stack([op @ kept, op @ Z])
+        return seen[key].copy()
 
     info = dict(basis.info, ritz_tail={"k": int(k), "points": pts.tolist(), "added": len(omega)})
     return ModalBasis(
