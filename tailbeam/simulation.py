@@ -136,8 +136,8 @@ def stream_band(scene) -> dict:
         "sensor_band_covered": bool(fmax >= f_sensor), "truncation_force_error": 0.0,
         "two_way": two_way,
         "coupling": (
-            "two-way (the modes in the stream solver's active set; no residual flexibility "
-            "at the contacts)" if two_way
+            "two-way (the modes in the stream solver's active set; residual flexibility at "
+            f"the contacts {'on' if settings.residual_flexibility else 'off'})" if two_way
             else "one-way (stream contacts on the rigid plate drive the modes)"
         ),
     }  # fmt: skip
@@ -155,10 +155,12 @@ def _basis_and_damping(scene, band):
 
 def _stream_plate(scene, band):
     """The two-way modal plate of a stream scene (tailbeam.solvers.stream_plate)."""
+    from tailbeam.scene import ModalPlateSettings
     from tailbeam.solvers.stream_plate import StreamPlate
 
     basis, zeta = _basis_and_damping(scene, band)
-    return StreamPlate(basis, zeta)
+    settings = scene.modal or ModalPlateSettings()
+    return StreamPlate(basis, zeta, residual_flexibility=settings.residual_flexibility)
 
 
 def _modal_sensors(scene, result, band, plate):

@@ -42,6 +42,30 @@ def ten_ball_scene(incline):
     ]
 
 
+def modal_scene(incline):
+    """Seven balls whose contacts all end within 28 ms (short runs of the slow reference
+    on the modal plate, where the modes bound its steps):
+
+    - b1, b2, b3 in a row along y, falling at 1 m/s: b1 and b3 reach b2 at once (~20 ms,
+      a 3-ball cluster), then all three land (~26 ms);
+    - s1 rests on the plate (static penetration), s2 falls onto it (~14 ms: ball-ball and
+      ball-plate contact at once);
+    - f1 lands obliquely (~8 ms) and p1 lands near an edge (~15 ms), exciting the plate
+      under the others.
+    """
+    r_s1 = 0.03
+    z_s1 = r_s1 - static_penetration_on(COAL, r_s1, incline)
+    return [
+        Ball("b1", COAL, 0.02, (-0.1, -0.06, 0.05), (0.0, 1.0, -1.0)),
+        Ball("b2", COAL, 0.02, (-0.1, 0.0, 0.05), (0.0, 0.0, -1.0)),
+        Ball("b3", COAL, 0.02, (-0.1, 0.06, 0.05), (0.0, -1.0, -1.0)),
+        Ball("s1", COAL, r_s1, (0.1, 0.1, z_s1), (0.0, 0.0, 0.0)),
+        Ball("s2", SANDSTONE, 0.02, (0.1, 0.1, 0.09), (0.0, 0.0, -0.5)),
+        Ball("f1", SANDSTONE, 0.035, (-0.15, -0.2, 0.05), (0.3, 0.2, -2.0)),
+        Ball("p1", COAL, 0.025, (0.2, -0.2, 0.05), (-0.2, 0.3, -1.5)),
+    ]
+
+
 def leave_scene(incline):
     """Four balls on a steep incline that leave the plate (30 deg suits them):
 

@@ -7,6 +7,7 @@ work; the gravity key is checked against the closed-form fall and rebound.
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -14,6 +15,7 @@ from pathlib import Path
 import pytest
 
 import tailbeam
+from tailbeam.cachedir import source_fingerprint
 from tailbeam.cli import main
 from tailbeam.hertz import free_fall_apex
 
@@ -50,10 +52,32 @@ def test_numba_cache_lives_outside_the_package(tmp_path):
     out = subprocess.run(
         [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
     )
-    assert Path(out.stdout.strip()) == tmp_path / "numba"
+    assert Path(out.stdout.strip()) == tmp_path / "numba" / source_fingerprint()
     assert any((tmp_path / "numba").rglob("*.nbi"))
     package = Path(tailbeam.__file__).parent
     assert not list(package.rglob("*.nbi")) and not list(package.rglob("*.nbc"))
+
+
+def test_numba_cache_follows_every_source_file(tmp_path):
+    """numba checks a cached kernel against its own file only; the cache folder is keyed by
+    every tailbeam source file, so editing any module (a helper a kernel calls or inlines, a
+    constant it reads) gives a new folder, never a stale kernel."""
+    package = tmp_path / "tailbeam"
+    shutil.copytree(
+        Path(tailbeam.__file__).parent, package, ignore=shutil.ignore_patterns("__pycache__")
+    )
+    code = "import tailbeam.cachedir as c; print(c.source_fingerprint())"
+
+    def fingerprint():
+        out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                             text=True, check=True)  # fmt: skip
+        return out.stdout.strip()
+
+    before = fingerprint()
+    assert before == source_fingerprint()  # same sources, same folder (another checkout too)
+    helper = package / "solvers" / "active_pairs.py"
+    helper.write_text(helper.read_text() + "\n# edited\n")
+    assert fingerprint() != before
 
 
 def test_ci_runs_the_readme_commands_verbatim():

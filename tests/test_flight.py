@@ -46,6 +46,8 @@ def test_plate_band_and_edge_times_are_the_closed_forms():
     t = band_time(0.021, v, -g, 0.022)
     assert 0.021 + v * t - 0.5 * g * t * t == pytest.approx(0.022, abs=1e-15)
     assert band_time(0.021, 0.01, -g, 0.022) == math.inf  # apex below the band
+    # inside the band and descending: now (its crossing lies in the past, never returned)
+    assert band_time(0.021, -0.5, -g, 0.022) == 0.0
     a = g * math.sin(math.radians(30))
     tau, edge = edge_time(np.array([0.1, 0.0, 0.02]), np.array([0.2, 0.0, 0.0]),
                           np.array([a, 0.0, 0.0]), (0.3, 0.3))  # fmt: skip

@@ -13,7 +13,10 @@ With the optional modal plate (m modes after the balls in the state, ``active_pa
 plate's deflection under a plate pair at the 15 points and at the force-row nodes comes from
 the modes projected on that pair's phi first (``_project``, ``_ensure_plate``: O(m) per pair
 and step); the far-pair bound adds sum |phi_k| B_k; the error norm is taken per block (balls,
-modes). Without modes every operation and result is the rigid plate's, bit for bit.
+modes). Without modes every operation and result is the rigid plate's, bit for bit. With
+residual flexibility at a plate pair (``active_pairs.plate_force_with_residual``) its
+full-damping row, like the clamp row, is sampled at the 15 points and closed by Illinois
+(the law's delta is no polynomial on the step); the contact row stays the polynomial gap.
 
 Event handling is the reference's (``stream_reference``): a step in which a row crosses is
 discarded and redone to end exactly at the crossing, and the redone step is checked again
@@ -32,6 +35,7 @@ from numba import njit
 from tailbeam.solvers.active_pairs import (
     L_C,
     L_CLAMP,
+    L_CRES,
     L_D,
     R_CLAMP,
     R_CONTACT,
@@ -254,18 +258,45 @@ def _dense_projected(c8, s):
 
 
 @helper_njit
-def _ensure_plate(W15, have_w, coef, y, pts, phi, p, n, proj):
-    """The plate's deflection and velocity under plate pair p at the 15 Chebyshev points of
-    the step (once per step): the modes projected on phi[p] first (O(modes), not 15 x modes)."""
+def _ensure_plate(W15, have_w, coef, y, pts, model, p, proj):
+    """The plate's deflection, velocity and free acceleration (``_project_plate``) under plate
+    pair p at the 15 Chebyshev points of the step, and kappa (once per step)."""
     if have_w[p]:
         return
     have_w[p] = True
-    nm = phi.shape[1]
-    _project(coef, y, phi, p, 6 * n, proj[0])
-    _project(coef, y, phi, p, 6 * n + nm, proj[1])
+    kappa = _project_plate(coef, y, model, p, proj)
     for q in range(pts.shape[0]):
         W15[q, p, 0] = _dense_projected(proj[0], pts[q])
         W15[q, p, 1] = _dense_projected(proj[1], pts[q])
+        W15[q, p, 2] = _dense_projected(proj[2], pts[q])
+        W15[q, p, 3] = kappa
+
+
+@helper_njit
+def _project_plate(coef, y, model, p, proj):
+    """The dense outputs (``_project``) of the plate under plate pair p of the step: w, w' and
+    acc0 = -g_z + phi[p] . (f_dead - 2 zeta omega q' - omega^2 q) (``plate_free_acceleration``)
+    into proj[0..2]; returns kappa = 1/m + phi[p] . phi[p] (1/kg). The modes projected on
+    phi[p] first: O(modes) per step, not per point."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    n = mass.shape[0]
+    nm = phi.shape[1]
+    off = 6 * n
+    _project(coef, y, phi, p, off, proj[0])
+    _project(coef, y, phi, p, off + nm, proj[1])
+    acc = proj[2]
+    for i in range(8):
+        acc[i] = 0.0
+    acc[7] = -g[2]
+    kappa = 1.0 / mass[pi[p]]
+    for k in range(nm):
+        c = phi[p, k]
+        a, b = -c * omega[k] * omega[k], -2.0 * c * zeta[k] * omega[k]
+        for i in range(7):
+            acc[i] += a * coef[i, off + k] + b * coef[i, off + nm + k]
+        acc[7] += a * y[off + k] + b * y[off + nm + k] + c * fdead[k]
+        kappa += c * c
+    return kappa
 
 
 @helper_njit
@@ -287,6 +318,8 @@ def _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp, phi):
         f = c + half[e // 2] if e % 2 == 0 else half[e // 2] - c
         return f + 1e-13 - B[3 * b + e // 2] > 0.0  # (EDGE_BAND)
     i, j, rs = pi[idx], pj[idx], rsum[idx]
+    if kind == R_FULL and j < 0 and law[idx, L_CRES] > 0.0:
+        return False  # (the law's delta lags the gap by C F: no bound from the gap alone)
     if j < 0:
         dist0, reach = y[3 * i + 2], B[3 * i + 2]
         nm = phi.shape[1]
@@ -319,18 +352,20 @@ def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, 
         _ensure(Y15, have, coef, y, pts, pi[idx])
         _ensure(Y15, have, coef, y, pts, pj[idx])
     if kind != R_EDGE and pj[idx] < 0:
-        _ensure_plate(W15, have_w, coef, y, pts, phi, idx, n, proj)
+        _ensure_plate(W15, have_w, coef, y, pts, model, idx, proj)
         i = pi[idx]
         for q in range(pts.shape[0]):
             vals[q] = plate_row_value(kind, idx, Y15[q, 3 * i + 2], Y15[q, 3 * n + 3 * i + 2],
-                                      W15[q, idx, 0], W15[q, idx, 1], law, rsum, touching, ramp,
+                                      W15[q, idx, 0], W15[q, idx, 1], W15[q, idx, 2],
+                                      W15[q, idx, 3], law, rsum, touching, ramp,
                                       clamped)  # fmt: skip
     else:
         for q in range(pts.shape[0]):
             vals[q] = row_value_arrays(
                 kind, idx, Y15[q], n, half, pi, pj, law, rsum, touching, ramp, clamped, phi
             )
-    if kind == R_CLAMP:
+    if kind == R_CLAMP or (kind == R_FULL and pj[idx] < 0 and law[idx, L_CRES] > 0.0):
+        # (not polynomials on the step: the clamp indicator; the law's delta with residual)
         return _sampled_crossing(kind, idx, vals, fr, y, coef, pts, model, pstate, tmp)
     cheb_coefficients(vals, vinv, wc)
     if certified(wc):
@@ -430,14 +465,15 @@ def _pair_values(p, dense, pts, model, pstate, forces, deltas):
     if j >= 0:
         _ensure(Y15, have, coef, y, pts, j)
         for q in range(pts.shape[0]):
-            f, delta, _, _, _ = pair_force(Y15[q], n, p, pi, pj, law, rsum, ramp, clamped, phi)
+            f, delta, _, _, _ = pair_force(Y15[q], n, p, pi, pj, law, rsum, ramp, clamped, phi,
+                                           mass, g, omega, zeta, fdead)  # fmt: skip
             forces[q], deltas[q] = f, delta
         return
-    _ensure_plate(W15, have_w, coef, y, pts, phi, p, n, proj)
+    _ensure_plate(W15, have_w, coef, y, pts, model, p, proj)
     for q in range(pts.shape[0]):
         forces[q], deltas[q] = plate_force(p, Y15[q, 3 * i + 2], Y15[q, 3 * n + 3 * i + 2],
-                                           W15[q, p, 0], W15[q, p, 1], law, rsum, ramp,
-                                           clamped)  # fmt: skip
+                                           W15[q, p, 0], W15[q, p, 1], W15[q, p, 2],
+                                           W15[q, p, 3], law, rsum, ramp, clamped)  # fmt: skip
 
 
 @helper_njit
@@ -447,19 +483,18 @@ def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj):
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     ramp, clamped = pstate[1], pstate[2]
     n = mass.shape[0]
-    nm = phi.shape[1]
     i = pi[p]
-    wq, wv = proj[0], proj[1]
-    _project(coef, y, phi, p, 6 * n, wq)
-    _project(coef, y, phi, p, 6 * n + nm, wv)
+    kappa = _project_plate(coef, y, model, p, proj)
+    wq, wv, wa = proj[0], proj[1], proj[2]
     for k in range(1, nodes + 1):
         s = k / (nodes + 1.0)
         z = _dense1(coef, y, s, 3 * i + 2)
         vz = _dense1(coef, y, s, 3 * n + 3 * i + 2)
-        f = plate_force(p, z, vz, _dense_projected(wq, s), _dense_projected(wv, s), law, rsum,
-                        ramp, clamped)[0]  # fmt: skip
+        f = plate_force(p, z, vz, _dense_projected(wq, s), _dense_projected(wv, s),
+                        _dense_projected(wa, s), kappa, law, rsum, ramp, clamped)[0]  # fmt: skip
         _write_row(rows, iout, t + s * h, p, f)
-    f = pair_force(ynew, n, p, pi, pj, law, rsum, ramp, clamped, phi)[0]
+    f = pair_force(ynew, n, p, pi, pj, law, rsum, ramp, clamped, phi, mass, g, omega, zeta,
+                   fdead)[0]  # fmt: skip
     _write_row(rows, iout, t + h, p, f)
 
 
@@ -476,7 +511,8 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
         return ST_LEAVE
     iout[IO_INDEX] = idx
     if kind == R_CONTACT:
-        f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi)[0]
+        f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi, mass, g, omega, zeta,
+                       fdead)[0]  # fmt: skip
         if touching[idx]:
             if pj[idx] < 0:
                 _write_row(rows, iout, t, idx, f)
@@ -486,9 +522,9 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
         delta = pair_state(y, n, pi[idx], pj[idx], rsum[idx], phi, idx)[0]
         peak[idx], t_peak[idx], pen[idx] = 0.0, math.nan, max(0.0, delta)
         if pj[idx] < 0:
-            _write_row(
-                rows, iout, t, idx, pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi)[0]
-            )
+            f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi, mass, g, omega,
+                           zeta, fdead)[0]  # fmt: skip
+            _write_row(rows, iout, t, idx, f)
         return ST_START
     r = iout[IO_LOG]
     if kind == R_FULL:
@@ -577,8 +613,8 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
     nb = model[0].shape[0]
     npairs = model[4].shape[0]
     dense = (np.zeros((npts, nst)), np.zeros(nb, dtype=np.bool_), coef, np.zeros(nst),
-             np.zeros(nst), np.zeros((npts, npairs, 2)), np.zeros(npairs, dtype=np.bool_),
-             np.zeros((2, 8)))  # fmt: skip
+             np.zeros(nst), np.zeros((npts, npairs, 4)), np.zeros(npairs, dtype=np.bool_),
+             np.zeros((3, 8)))  # fmt: skip
     ws = (np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts),
           np.zeros((256, 3)), np.zeros(nst))  # fmt: skip
     count = np.zeros(nb, dtype=np.int64)

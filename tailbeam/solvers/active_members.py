@@ -6,6 +6,11 @@ set is rebuilt on the next ``advance`` after a change, carrying over each pair's
 (touching, region flags, peak force, maximum penetration) by its key: (i, -1) for ball i on
 the plate, (i, j) with i < j for two balls. Every pair among the members is watched (sets are
 small: the balls near a contact).
+
+On the modal plate each plate pair also gets the residual compliance (m/N) of the truncated
+modes at the point of its mode shapes (``StreamPlate.compliance``, cached by point): when its
+contact starts (the force is 0 then, so nothing jumps) or it is put at rest; carried over
+with the shapes while it touches.
 """
 
 import math
@@ -13,8 +18,9 @@ import math
 import numpy as np
 
 from tailbeam.contact_law import ball_ball_law
+from tailbeam.contact_patch import load_radius
 from tailbeam.physics.incline import EDGES
-from tailbeam.solvers.active_pairs import elastic_energy, first_contact_step, settle_excess
+from tailbeam.solvers.active_pairs import L_CRES, first_contact_step, settle_excess
 from tailbeam.solvers.active_set import ActiveSet, law_table
 
 SHAPE_REUSE = 2.5e-4  # m: mode shapes computed within this distance are reused (modal plate)
@@ -40,6 +46,8 @@ class ActiveMembers:
         self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
         self.totals = {"kernel_steps": 0, "kernel_attempts": 0, "kernel_nfev": 0, "rebuilds": 0}
         self._shape_cache = {}  # ball -> (xy, mode shapes there): modal plate
+        self._phi_xy = {}  # plate pair key -> the point (x, y) of its mode shapes
+        self._load_radii = {}  # ball -> radius (m) of its load model (contact_patch)
         self._x = {}  # state of members added since the last build
         self._v = {}
 
@@ -69,6 +77,8 @@ class ActiveMembers:
         self._pairs = {k: self._pair_state(p) for k, p in self.index.items()}
         if self.plate is not None:  # each plate pair keeps its mode shapes (its contact point)
             self._phi = {k: self.set.phi[p].copy() for k, p in self.index.items() if k[1] < 0}
+            self._cres = {k: self.set.law[p, L_CRES] for k, p in self.index.items() if k[1] < 0}
+            self._phi_xy = {k: xy for k, xy in self._phi_xy.items() if k in self._phi}
 
     def _pair_state(self, p):
         s = self.set
@@ -120,21 +130,41 @@ class ActiveMembers:
             return {}
         plate.propagate(self.now)
         plate.set_dead_loads(*self.dead_loads())
-        kept = getattr(self, "_phi", {})
+        kept, kept_c = getattr(self, "_phi", {}), getattr(self, "_cres", {})
         new = [i for i in members if (i, -1) not in kept]
-        shapes = dict(zip(new, self._shapes(new, [self._x[i][:2] for i in new]), strict=True))
+        new_phi, new_xy = self._shapes(new, [self._x[i][:2] for i in new])
+        shapes = dict(zip(new, new_phi, strict=True))
+        self._phi_xy.update({(i, -1): new_xy[k] for k, i in enumerate(new)})
         phi = np.zeros((len(self.keys), plate.n_modes))
+        cres = np.zeros(len(self.keys))
         for q, i in enumerate(members):  # the plate pairs come first, in member order
-            phi[q] = kept[(i, -1)] if (i, -1) in kept else shapes[i]
-        for q, i in enumerate(members):
+            key = (i, -1)
+            phi[q], cres[q] = (kept[key], kept_c[key]) if key in kept else (shapes[i], 0.0)
             if i in self.quiet:
-                self._x[i][2] = self.balls.radius[i] - self.balls.static_pen[i] + phi[q] @ plate.q
+                cres[q] = self._compliance(key)
+                self._x[i][2] = self._static_height(i, cres[q]) + phi[q] @ plate.q
         atol_x = self.rtol * 1e-3
         scale = float(np.max(plate.phi_max))
         return dict(
             omega=plate.omega, zeta=plate.zeta, q=plate.q, qd=plate.qd, phi=phi,
             f_dead=plate.f_dead, atol_q=atol_x / scale, atol_qd=self.rtol / scale,
+            compliance=cres,
         )  # fmt: skip
+
+    def _static_height(self, i: int, cres: float) -> float:
+        """Height (m) of ball i resting on the undeflected plate: its static penetration,
+        plus the residual spring's C m g_n in series (modal plate)."""
+        b = self.balls
+        return b.radius[i] - b.static_pen[i] - cres * b.mass[i] * -b.g[2]
+
+    def _load_radius(self, i: int) -> float:
+        """Radius (m) of the disc ball i's force is spread over in the residual compliance
+        (tailbeam.contact_patch: 0 on a Kirchhoff basis; the Hertz radius on Mindlin)."""
+        if i not in self._load_radii:
+            b = self.balls
+            self._load_radii[i] = load_radius(self.plate.basis.theory, b.particles[i].ball(),
+                                              b.plate_laws[i], float(-b.g[2]))  # fmt: skip
+        return self._load_radii[i]
 
     def refresh_shapes(self):
         """Modal plate: the mode shapes of every plate pair not touching, at its ball's
@@ -145,25 +175,39 @@ class ActiveMembers:
         free = [(q, i) for q, i in enumerate(self.members) if not s.touching[self.index[(i, -1)]]]
         if not free:
             return
-        shapes = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
-        for (_, i), shape in zip(free, shapes, strict=True):
+        shapes, points = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
+        for (_, i), shape, xy in zip(free, shapes, points, strict=True):
             p = self.index[(i, -1)]
             # only where the change of the plate under the ball cannot close its gap (a
             # ball just off the plate keeps its shapes: no start or end out of nothing)
             gap = -s.penetration(p)[0]
             if gap > abs((shape - s.phi[p]) @ s.q) + 1e-9:
                 s.set_phi(p, shape)
+                s.set_compliance(p, 0.0)  # (set when its contact starts)
+                self._phi_xy[(i, -1)] = xy
 
-    def _shapes(self, balls, xy) -> np.ndarray:
-        """Mode shapes under ``balls`` at ``xy``: each ball's cached row unless it moved more
-        than SHAPE_REUSE since it was computed (one batched evaluation for the rest)."""
+    def _compliance(self, key) -> float:
+        """Residual compliance (m/N) of plate pair ``key`` at the point of its mode shapes."""
+        i = key[0]
+        return float(self.plate.compliance([self._phi_xy[key]], [self._load_radius(i)])[0])
+
+    def _set_compliance(self, key):
+        """Modal plate: plate pair ``key`` (touching from now) gets its residual compliance."""
+        if self.plate is not None and key[1] < 0:
+            self.set.set_compliance(self.index[key], self._compliance(key))
+
+    def _shapes(self, balls, xy) -> tuple[np.ndarray, np.ndarray]:
+        """Mode shapes (len, m) under ``balls`` at ``xy`` and the points (len, 2) they were
+        computed at: each ball's cached row unless it moved more than SHAPE_REUSE since it
+        was computed (one batched evaluation for the rest)."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
         out = np.empty((len(balls), self.plate.n_modes))
+        points = xy.copy()
         todo = []
         for k, i in enumerate(balls):
             cached = self._shape_cache.get(i)
             if cached is not None and np.hypot(*(cached[0] - xy[k])) <= SHAPE_REUSE:
-                out[k] = cached[1]
+                points[k], out[k] = cached
             else:
                 todo.append(k)
         if todo:
@@ -171,7 +215,7 @@ class ActiveMembers:
             for k, row in zip(todo, fresh, strict=True):
                 out[k] = row
                 self._shape_cache[balls[k]] = (xy[k].copy(), row)
-        return out
+        return out, points
 
     def _count(self):
         if self.set is not None:
@@ -201,6 +245,8 @@ class ActiveMembers:
         if kind is None:
             return None, None, out.t
         if kind in ("start", "end"):
+            if kind == "start":
+                self._set_compliance(self.keys[out.index])
             return kind, self.keys[out.index], out.t
         ball = self.members[out.index]
         return kind, (ball, EDGES[out.edge]) if kind == "leave" else ball, out.t
@@ -252,11 +298,7 @@ class ActiveMembers:
         s = self._ready()
         q = [self.local[int(i)] for i in balls]
         kinetic = 0.5 * float(np.sum(s.mass[q] * np.sum(s.v[q] * s.v[q], axis=1)))
-        elastic = 0.0
-        for p in np.flatnonzero(s.touching):
-            delta, _ = s.penetration(p)
-            k, e = s.law[p, 0], s.law[p, 1]
-            elastic += elastic_energy(delta, k, e)
+        elastic = sum(s.contact_energy(p) for p in np.flatnonzero(s.touching))
         return kinetic + elastic
 
     def elastic_energy_of(self, i: int) -> float:
@@ -265,11 +307,8 @@ class ActiveMembers:
         s = self._ready()
         total = 0.0
         for key in self.touching_pairs(i):
-            p = self.index[key]
-            delta, _ = s.penetration(p)
-            k, e = s.law[p, 0], s.law[p, 1]
             share = 1.0 if key[1] < 0 else 0.5
-            total += share * elastic_energy(delta, k, e)
+            total += share * s.contact_energy(self.index[key])
         return total
 
     def touching_pairs(self, i: int) -> list:
@@ -283,6 +322,7 @@ class ActiveMembers:
         delta, _ = s.penetration(p)
         s.touching[p], s.ramp[p], s.clamped[p] = True, True, False
         s.peak[p], s.t_peak[p], s.pen[p] = 0.0, math.nan, max(delta, 0.0)
+        self._set_compliance(key)
         step = first_contact_step(s.y, s.model(), p, self.rtol)
         self.h = min(self.h, step) if self.h else step
 
@@ -306,7 +346,8 @@ class ActiveMembers:
         if not s.touching[p]:  # a slow rebound: the energy of the normal motion above rest
             removed = 0.5 * s.mass[q] * s.v[q, 2] ** 2
         w, wd = (s.phi[p] @ s.q, s.phi[p] @ s.qd) if self.plate is not None else (0.0, 0.0)
-        s.x[q, 2] = self.balls.radius[i] - self.balls.static_pen[i] + w
+        self._set_compliance((i, -1))
+        s.x[q, 2] = self._static_height(i, s.law[p, L_CRES]) + w
         s.v[q, 2] = wd
         law = s.law[p]
         s.touching[p] = True

@@ -25,8 +25,10 @@ balls; each plate pair has the mode shapes phi (m,) at its contact point (fixed 
 given by the caller); the plate under the ball deflects by w = phi . q, the penetration is
 r - (z - w), the ball's force F (+z) loads the modes with -phi F; constant dead loads f_dead
 (m,) on the modes. The plate gap z - w is still a polynomial on a step, so events are located
-as on the rigid plate. No residual flexibility of the truncated modes (``NOTES-modal2.md``
-measures what that costs). Without modes every result is bit-for-bit the rigid plate's.
+as on the rigid plate. Residual flexibility (optional): each plate pair may have the static
+compliance C (m/N) of the truncated modes at its contact point in series with the contact
+(``compliance``, ``set_compliance``; ``active_pairs.plate_force_with_residual``). Without
+modes (and C = 0) every result is bit-for-bit the rigid plate's.
 
 Everything in the plate frame (x downhill, z the plate normal, surface z = 0), SI units.
 Cost per step: O(balls + pairs watched). The first call compiles the kernel (cached on disk).
@@ -41,7 +43,12 @@ from tailbeam.contact_law import ball_ball_law, ball_plate_law
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.rigid.kernel import dop853_tables
 from tailbeam.solvers import active_kernel as ak
-from tailbeam.solvers.active_pairs import clamp_indicator, pair_state
+from tailbeam.solvers.active_pairs import (
+    L_CRES,
+    clamp_indicator,
+    pair_state,
+    plate_contact_energy,
+)
 from tailbeam.solvers.cheb_events import tables as cheb_tables
 from tailbeam.solvers.modal_block import ModalBlock
 
@@ -85,18 +92,19 @@ def pair_laws(balls, pairs, plate_material, **options):
 class ActiveSet:
     """n balls and P watched pairs, advanced by the compiled kernel.
 
-    x, v: (n, 3) positions (m) and velocities (m/s), views of the state (in/out); mass (n,)
-    kg; radius (n,) m; pairs: (P, 2) ball indices (j = -1: the plate); laws: P ``ImpactLaw``s
-    (or a (P, 5) ``law_table``); gravity (3,) m/s^2 in the plate frame; half_sizes (a/2, b/2)
-    m; settle_energy (n,) J (0 = never); rtol; atol_x (m), atol_v (m/s) (default rtol x 1 mm,
-    rtol x 1 m/s, as the reference); max_steps per ``advance`` call; nodes_per_step: interior force
-    rows per step. Modal plate (optional, all m modes): omega (m,) rad/s, zeta (m,), q, qd (m,)
-    initial modal state (m sqrt(kg), m sqrt(kg)/s; default 0), phi (P, m) mode shapes at each
-    pair's contact point in 1/sqrt(kg) (rows of ball-ball pairs ignored; ``set_phi`` changes
-    a row for a new contact), f_dead (m,) constant modal forces in N/sqrt(kg) (balls resting
-    quasi-statically elsewhere); atol_q, atol_qd (default atol_x / s, atol_v / s with
-    s = max |phi| at construction, so that the deflection under a ball is held to about
-    atol_x; pass them when phi is only set later).
+    x, v: (n, 3) positions (m) and velocities (m/s), views of the state (in/out); mass (n,) kg;
+    radius (n,) m; pairs: (P, 2) ball indices (j = -1: the plate); laws: P ``ImpactLaw``s (or a
+    (P, 5) ``law_table``; kept as (P, 6) with the compliance); gravity (3,) m/s^2 in the plate
+    frame; half_sizes (a/2, b/2) m; settle_energy (n,) J (0 = never); rtol; atol_x (m), atol_v
+    (m/s) (default rtol x 1 mm, rtol x 1 m/s, as the reference); max_steps per ``advance`` call;
+    nodes_per_step: interior force rows per step. Modal plate (optional, all m modes): omega
+    (m,) rad/s, zeta (m,), q, qd (m,) initial modal state (m sqrt(kg), m sqrt(kg)/s; default 0),
+    phi (P, m) mode shapes at each pair's contact point in 1/sqrt(kg) (rows of ball-ball pairs
+    ignored; ``set_phi`` changes a row for a new contact), f_dead (m,) constant modal forces in
+    N/sqrt(kg) (balls resting quasi-statically elsewhere); atol_q, atol_qd (default atol_x / s,
+    atol_v / s with s = max |phi| at construction, so that the deflection under a ball is held
+    to about atol_x; pass them when phi is only set later); compliance (P,) m/N: the residual
+    compliance of each plate pair (default 0; entries of ball-ball pairs ignored).
     ``q``, ``qd``: views of the modal state (in/out). Per-pair state (in/out): touching, ramp,
     clamped, peak (N), t_peak (s), pen (m, max penetration). ``alive`` (n,): balls still
     integrated (False after a leave).
@@ -113,7 +121,7 @@ class ActiveSet:
                  settle_energy=None, rtol=1e-10, atol_x=None, atol_v=None, max_steps=100_000,
                  nodes_per_step=DEFAULT_NODES, row_capacity=4096, log_capacity=256,
                  omega=None, zeta=None, q=None, qd=None, phi=None, f_dead=None, atol_q=None,
-                 atol_qd=None):  # fmt: skip
+                 atol_qd=None, compliance=None):  # fmt: skip
         x = np.asarray(x, dtype=float).reshape(-1, 3)
         n = x.shape[0]
         npairs = np.asarray(pairs).reshape(-1, 2).shape[0]
@@ -134,7 +142,7 @@ class ActiveSet:
         self.pi, self.pj = pairs[:, 0].copy(), pairs[:, 1].copy()
         if not isinstance(laws, np.ndarray):
             laws = law_table(laws)
-        self.law = np.ascontiguousarray(laws, dtype=float).reshape(-1, 5)
+        self.law = _with_compliance(laws, self.pj, compliance)
         _check(n, self.pi, self.pj, self.law, rtol, nodes_per_step, max_steps)
         _check_positive("mass", self.mass)
         _check_positive("radius", self.radius)
@@ -196,6 +204,19 @@ class ActiveSet:
         """Mode shapes (m,) 1/sqrt(kg) at plate pair p's new contact point (before it touches)."""
         self.phi[p] = np.asarray(shape, dtype=float).reshape(self.phi.shape[1])
 
+    def set_compliance(self, p: int, compliance: float):
+        """Residual compliance (m/N) at plate pair p's new contact point (before it touches)."""
+        self.law[p, L_CRES] = _compliance_value(compliance)
+
+    def contact_energy(self, p: int) -> float:
+        """Elastic energy (J) of pair p now (0 when not touching; a plate pair's includes its
+        residual spring's C F^2 / 2)."""
+        if not self.touching[p]:
+            return 0.0
+        delta, _ = self.penetration(p)
+        k, e, cres = self.law[p, 0], self.law[p, 1], self.law[p, L_CRES]
+        return float(plate_contact_energy(delta, k, e, cres if self.pj[p] < 0 else 0.0))
+
     def modal_energy(self) -> float:
         """Kinetic + strain energy of the modes now, J: 1/2 (q'^2 + omega^2 q^2) summed."""
         return float(0.5 * np.sum(self.qd**2 + (self.omega * self.q) ** 2))
@@ -218,7 +239,7 @@ class ActiveSet:
             delta, rate = self.penetration(p)
             if delta <= 0.0:
                 continue
-            k, e, c, d, clamp = self.law[p]
+            k, e, c, d, clamp = self.law[p, :5]
             self.touching[p] = True
             self.ramp[p] = delta < d or c <= 0.0
             ind = clamp_indicator(delta, rate, k, e, c, d, self.ramp[p])
@@ -290,6 +311,27 @@ class ActiveSet:
         """Accepted steps, attempted steps and right-hand-side evaluations so far."""
         return {"steps": int(self.iout[ak.IO_STEPS]), "attempts": int(self.iout[ak.IO_ATTEMPTS]),
                 "nfev": int(self.iout[ak.IO_NFEV])}  # fmt: skip
+
+
+def _with_compliance(laws, pj, compliance) -> np.ndarray:
+    """(P, 6) law table: a (P, 5) ``law_table`` and the residual compliance of each plate
+    pair (m/N; 0 for ball-ball pairs and when ``compliance`` is None)."""
+    laws = np.asarray(laws, dtype=float)
+    laws = laws if laws.ndim == 2 else laws.reshape(-1, 5)
+    if laws.shape[0] != len(pj):
+        raise InputError("laws", f"one law per pair: got {len(laws)} laws for {len(pj)} pairs")
+    laws = laws[:, :5]
+    cres = np.zeros(len(pj)) if compliance is None else np.asarray(compliance, dtype=float)
+    if cres.shape != (len(pj),) or not np.all(np.isfinite(cres)) or np.any(cres < 0.0):
+        raise InputError("compliance", f"must be {len(pj)} finite values >= 0 m/N (one per pair)")
+    return np.ascontiguousarray(np.column_stack([laws, np.where(pj < 0, cres, 0.0)]))
+
+
+def _compliance_value(value) -> float:
+    value = float(value)
+    if not (math.isfinite(value) and value >= 0.0):
+        raise InputError("compliance", f"must be finite and >= 0 m/N, got {value!r}")
+    return value
 
 
 def _check_positive(name, values):

@@ -95,9 +95,12 @@ def plate_time(z0: float, vz: float, az: float, radius: float) -> float:
 
 def band_time(z0: float, vz: float, az: float, height: float) -> float:
     """Time (s) until a flying ball's centre comes down to ``height`` (m) above the plate
-    (z may start below it: then the descending crossing), or inf if its apex stays below."""
+    (z may start below it: then the descending crossing; 0 if it is below and not rising:
+    it is in the band now, never a time in the past), or inf if its apex stays below."""
     gn = -az
     gap = z0 - height
+    if gap < 0.0 and vz <= 0.0:
+        return 0.0
     if gn <= 0.0:
         return max(gap, 0.0) / -vz if vz < 0.0 else NEVER
     disc = vz * vz + 2.0 * gn * gap

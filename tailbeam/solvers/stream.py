@@ -606,7 +606,9 @@ class _Stream(StreamRecords):
         b.in_set[i] = False
         if b.status[i] == SLIDE:
             b.slide_since[i] = self.t
-        self._predict_pairs(i)  # its pairs with balls the set watched are no longer watched
+        # its own events (a plate touch or edge crossing that came due while the set watched
+        # it was dropped then) and its pairs with the balls the set watched
+        self._predict(i)
 
     def _refresh_set(self):
         """Core = members with a contact in progress; members = core + every closed-form

@@ -12,21 +12,38 @@ energy about its static position under the dead loads cannot grow while only the
 loads act, so |q_k| <= |s_k| + sqrt((q_k - s_k)^2 + (q'_k / omega_k)^2), s_k = f_k / omega_k^2.
 The stream driver predicts a flying ball's plate touch that far above the plate, so that the
 integrator (which sees the vibrating plate) finds the real start.
+
+Residual flexibility (``residual_flexibility``, the scene's ``plate.residual_flexibility``,
+default on as in the single-ball coupled solver): ``compliance`` gives the static compliance
+of the truncated modes at a contact point (``tailbeam.coupled.records.Compliance``: the full
+model's static compliance minus the kept modes' part, cached per basis and point), which the
+active set puts in series with the contact.
 """
 
 import numpy as np
 
 from tailbeam.coupled.propagator import advance, coefficients
+from tailbeam.coupled.records import Compliance
+from tailbeam.errors import InputError
 
 GRID = 61  # points per side where max |phi_k| is sampled
 GRID_SAFETY = 1.1  # the sampled maximum, raised for peaks between grid points
 
 
 class StreamPlate:
-    """Modal state of the plate ``basis`` with damping ratios ``zeta`` (one per mode)."""
+    """Modal state of the plate ``basis`` with damping ratios ``zeta`` (one per mode); with
+    ``residual_flexibility`` the contacts get the truncated modes' static compliance."""
 
-    def __init__(self, basis, zeta):
+    def __init__(self, basis, zeta, residual_flexibility=True):
+        if residual_flexibility and basis.static_compliance_at is None:
+            raise InputError(
+                "plate.residual_flexibility",
+                f"the {basis.theory} {basis.boundary} basis has no static compliance (a plate "
+                "with rigid-body modes); set residual_flexibility = false",
+            )
         self.basis = basis
+        self.residual_flexibility = bool(residual_flexibility)
+        self._compliance = Compliance(basis, self.residual_flexibility)
         self.omega = np.ascontiguousarray(basis.omega, dtype=float)
         self.zeta = np.ascontiguousarray(zeta, dtype=float)
         n = self.omega.shape[0]
@@ -52,6 +69,14 @@ class StreamPlate:
     def shapes(self, xy) -> np.ndarray:
         """(p, m) mode shapes (1/sqrt(kg)) at points xy (p, 2) m: point loads."""
         return np.ascontiguousarray(self.basis.deflection(np.atleast_2d(xy)), dtype=float)
+
+    def compliance(self, xy, radii) -> np.ndarray:
+        """(p,) residual compliance (m/N) at points xy (p, 2) m for loads spread over discs
+        of ``radii`` (p,) m (``tailbeam.contact_patch.load_radius``; 0: a point load); all 0
+        when residual flexibility is off."""
+        xy = np.atleast_2d(np.asarray(xy, dtype=float))
+        return np.array([self._compliance(float(x), float(y), float(r))
+                         for (x, y), r in zip(xy, np.ravel(radii), strict=True)])  # fmt: skip
 
     def set_dead_loads(self, xy, weights) -> None:
         """Dead loads from now on: weights (N, pressing down) at points xy (p, 2)."""

@@ -1,4 +1,5 @@
-"""Slow, independent reference for streams: all balls and a rigid inclined plate together.
+"""Slow, independent reference for streams: all balls and the inclined plate together, the
+plate rigid or modal (two-way, ``plate=ReferencePlate(...)``, see below).
 
 One ODE for every ball (3-D translation, frictionless, normal forces only, no rotation),
 integrated by scipy's DOP853 (the method of ``solve_ivp(method="DOP853")``, driven step by
@@ -26,10 +27,26 @@ straddled the kink can be late). Each event fires when its function passes a dea
 beyond zero (see ``_Reference.rows``), against round-off chatter at grazing contacts.
 Peak force and maximum penetration: the maximum of their Chebyshev interpolant on each
 step. Balls may enter later (``release_times``).
+
+Modal plate (``tailbeam.solvers.reference_plate``: the model, exact or frozen mode shapes).
+The state gains the modal coordinates [q | q'] after the balls (atol: deflections to rtol x
+1 mm, rates to rtol x 1 m/s). A ball's plate rows use the gap z - w, w = phi(x, y) . q.
+What is certified: with frozen shapes (a contact's) the rows are polynomials of degree
+<= 14 on a step, as above. With exact shapes phi(x(s), y(s)) is not a polynomial; the 15
+values are exact samples, and the certificate and the root search act on their
+interpolant. Every step is bounded so that no ball moves sideways more than 1 / k_max
+(k_max: the top mode's wavenumber; the step is redone shorter otherwise): along such a path
+each shape's Chebyshev coefficients fall like (k L / 4)^n / n!, and the interpolant misses
+the row only by products of them with the top coefficients of the dense output (~rtol):
+an estimate (~1e-12 of the row's scale; measured 1.5e-14 of r^2), not a certificate. A
+crossing found on the interpolant is applied only where the true row lies within its dead
+band (else the step goes on and finds it again, closer), so no event is applied early; a
+dip narrower than that estimate could be missed. The modes also bound the steps (at least
+MODAL_STEPS_PER_PERIOD per period of the top mode: too long a run is refused at once).
 """
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.integrate import DOP853
@@ -49,6 +66,7 @@ from tailbeam.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES, InclinedPlate
 from tailbeam.physics.pair import pair_kinematics, plate_foot
 from tailbeam.solvers.records import PLATE, ContactRecord, EventKind, LeaveEvent
+from tailbeam.solvers.reference_plate import ReferencePlate
 from tailbeam.solvers.step_events import (
     STEP_POINTS,
     certified_positive,
@@ -58,6 +76,7 @@ from tailbeam.solvers.step_events import (
 )
 
 SAME_TIME = 1e-9  # events closer than this (fraction of a step) are simultaneous
+MODAL_STEPS_PER_PERIOD = 5  # a lower bound of the steps per period of the top mode
 
 
 @dataclass
@@ -75,6 +94,7 @@ class _Pair:
     peak: float = 0.0
     t_peak: float = math.nan
     pen: float = 0.0
+    phi0: np.ndarray | None = None  # shapes kept by a frozen plate contact (modal plate)
 
     @property
     def kinked(self) -> bool:
@@ -90,6 +110,7 @@ class _PairIndex:
     lj: np.ndarray
     is_plate: np.ndarray
     radius_sum: np.ndarray
+    frozen_phi: np.ndarray | None = None  # (P, m), NaN rows: shapes evaluated exactly
 
 
 @dataclass
@@ -118,6 +139,7 @@ class StreamReferenceResult:
     states: list
     steps: int
     info: dict
+    plate_states: list = field(default_factory=list)  # (q, q') per step (modal plate)
 
     def contacts_of(self, ball: str) -> list:
         return [c for c in self.contacts if c.ball == ball]
@@ -136,6 +158,7 @@ def simulate_stream_reference(
     max_steps: int = 200_000,
     release_times=None,
     progress=None,
+    plate: ReferencePlate | None = None,
 ) -> StreamReferenceResult:
     """Integrate ``balls`` (``tailbeam.Ball``, positions and velocities in the plate frame)
     on ``incline`` for ``duration`` s; see the module docstring.
@@ -146,6 +169,8 @@ def simulate_stream_reference(
     release_times (s, one per ball, default all 0): a ball enters the scene at its time, at
     its given position and velocity (event ``release``; the energy series jumps there).
     progress: optional callable, called with the time (s) reached after every accepted step.
+    plate: a ``ReferencePlate`` (the modal plate, two-way, ``tailbeam.solvers.reference_plate``)
+    or None (the rigid plate).
     """
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-3:
@@ -153,14 +178,21 @@ def simulate_stream_reference(
     options = dict(exponent=exponent, damping=damping, penetration=penetration, clamp=clamp)
     balls = list(balls)
     release = _release_times(release_times, len(balls))
-    sim = _Reference(balls, incline, options, rtol, max_steps, release)
+    if plate is not None:
+        if not isinstance(plate, ReferencePlate):
+            raise InputError("plate", "must be a ReferencePlate (a modal basis and its damping)")
+        plate.check_size(incline)
+        _check_modal_work(plate, duration, max_steps)
+    sim = _Reference(balls, incline, options, rtol, max_steps, release, plate)
     sim.progress = progress
     return sim.run(duration)
 
 
 class _Reference:
-    def __init__(self, balls, incline, options, rtol, max_steps, release):
+    def __init__(self, balls, incline, options, rtol, max_steps, release, plate=None):
         _check_balls(balls, incline)
+        self.plate, self.h_cap = plate, math.inf
+        self.trial_errors = {} if plate is None else dict(over="ignore", invalid="ignore")
         self.balls, self.incline, self.rtol, self.max_steps = balls, incline, rtol, max_steps
         self.g = incline.gravity_vector
         self.mass = np.array([b.mass for b in balls])
@@ -171,12 +203,13 @@ class _Reference:
         for i in self.active:
             self.add_pairs(i)
         self.contacts, self.leaves, self.events = [], [], []
-        self.times, self.energy, self.states = [], [], []
+        self.times, self.energy, self.states, self.plate_states = [], [], [], []
         self.steps = 0
         self.progress = None
         pos = np.array([balls[i].position for i in self.active], dtype=float).reshape(-1, 3)
         vel = np.array([balls[i].velocity for i in self.active], dtype=float).reshape(-1, 3)
-        self.y = np.concatenate([pos.ravel(), vel.ravel()])
+        m = 0 if plate is None else plate.n_modes
+        self.y = self.join(pos, vel, (np.zeros(m), np.zeros(m)) if m else None)
         self.t = 0.0
         self.touch(list(self.pairs.values()), 0.0)
 
@@ -184,7 +217,21 @@ class _Reference:
     def split(self, y):
         """Positions and velocities (n, 3) of the active balls from a state vector."""
         n = len(self.active)
-        return y[: 3 * n].reshape(n, 3), y[3 * n :].reshape(n, 3)
+        return y[: 3 * n].reshape(n, 3), y[3 * n : 6 * n].reshape(n, 3)
+
+    def modes(self, y):
+        """(q, q') of the modal plate from a state vector (or states (..., len)); None on the
+        rigid plate."""
+        if self.plate is None:
+            return None
+        off, m = 6 * len(self.active), self.plate.n_modes
+        return y[..., off : off + m], y[..., off + m : off + 2 * m]
+
+    @staticmethod
+    def join(x, v, modes):
+        """The state vector of positions, velocities (n, 3) and the modes (or None)."""
+        parts = [x.ravel(), v.ravel()] + ([] if modes is None else list(modes))
+        return np.concatenate(parts)
 
     def local(self):
         loc = np.full(len(self.balls), -1)
@@ -197,12 +244,27 @@ class _Reference:
         li = loc[[p.i for p in pairs]]
         lj = loc[[max(p.j, 0) for p in pairs]]
         is_plate = np.array([p.j < 0 for p in pairs], dtype=bool)
-        return _PairIndex(li, lj, is_plate, np.array([p.radius_sum for p in pairs]))
+        frozen = None
+        if self.plate is not None:
+            frozen = np.full((len(pairs), self.plate.n_modes), np.nan)
+            for k, p in enumerate(pairs):
+                if p.phi0 is not None:
+                    frozen[k] = p.phi0
+        return _PairIndex(li, lj, is_plate, np.array([p.radius_sum for p in pairs]), frozen)
 
-    def kinematics(self, pairs, x, v):
+    def kinematics(self, pairs, x, v, modes=None):
         """Kinematics of ``pairs`` (a list or its ``index``) at positions/velocities x, v of
-        shape (..., n, 3); also returns the local indices and the plate flags."""
+        shape (..., n, 3) (and modes (q, q'), each (..., m), on the modal plate); also returns
+        the local indices and the plate flags."""
+        if self.plate is not None:
+            return self.modal_kinematics(pairs, x, v, modes)[:4]
         ix = pairs if isinstance(pairs, _PairIndex) else self.index(pairs)
+        return self.rigid_kinematics(ix, x, v)[:4]
+
+    @staticmethod
+    def rigid_kinematics(ix, x, v):
+        """``kinematics`` against the undeformed plate; also returns the balls i's centres
+        and velocities (..., P, 3) and the radius sums (..., P)."""
         li, lj, is_plate = ix.li, ix.lj, ix.is_plate
         xi, vi = x[..., li, :], v[..., li, :]
         foot = plate_foot(xi.reshape(-1, 3)).reshape(xi.shape)
@@ -210,7 +272,22 @@ class _Reference:
         vj = np.where(is_plate[:, None], 0.0, v[..., lj, :])
         rsum = np.broadcast_to(ix.radius_sum, xi.shape[:-1])
         kin = pair_kinematics(*(a.reshape(-1, 3) for a in (xi, vi, xj, vj)), rsum.reshape(-1))
-        return kin, li, lj, is_plate
+        return kin, li, lj, is_plate, xi, vi, rsum
+
+    def modal_kinematics(self, pairs, x, v, modes):
+        """``kinematics`` on the modal plate (``ReferencePlate.contact_geometry``): plate
+        pairs' penetration and rate against the deflected plate; also returns their slope
+        (P', 2) and shapes (P', m), flattened over the leading axes as the kinematics."""
+        ix = pairs if isinstance(pairs, _PairIndex) else self.index(pairs)
+        kin, li, lj, is_plate, xi, vi, rsum = self.rigid_kinematics(ix, x, v)
+        gap, rate, slope, phi = self.plate.contact_geometry(xi, vi, is_plate, ix.frozen_phi, modes)
+        flat = np.broadcast_to(is_plate, rsum.shape).reshape(-1)
+        kin = replace(
+            kin,
+            penetration=np.where(flat, (rsum + gap).reshape(-1), kin.penetration),
+            rate=np.where(flat, rate.reshape(-1), kin.rate),
+        )
+        return kin, li, lj, is_plate, slope.reshape(-1, 2), phi.reshape(-1, self.plate.n_modes)
 
     # --- right-hand side ------------------------------------------------------------------
     def make_rhs(self):
@@ -220,6 +297,8 @@ class _Reference:
         clamped = np.array([p.clamped for p in pairs], dtype=bool)
         m = self.mass[self.active]
         ix = self.index(pairs)
+        if self.plate is not None:
+            return self.make_modal_rhs(pairs, laws, ramp, clamped, m, ix)
 
         def rhs(t, y):
             x, v = self.split(y)
@@ -232,6 +311,37 @@ class _Reference:
                 ball = ~is_plate
                 np.add.at(acc, lj[ball], -fn[ball] / m[lj[ball], None])
             return np.concatenate([v.ravel(), acc.ravel()])
+
+        return rhs
+
+    def make_modal_rhs(self, pairs, laws, ramp, clamped, m, ix):
+        """The right-hand side with the modal plate: the contacts' generalised forces
+        (``tailbeam.solvers.reference_plate``) on the balls (normal and slope) and modes."""
+        plate = self.plate
+
+        # A DOP853 trial step far too long for a stiff contact can overflow in its stages;
+        # the error estimate is then nan and DOP853 rejects the step and shrinks it (only
+        # accepted steps are used), so those warnings are silenced here.
+        def rhs(t, y):
+            with np.errstate(over="ignore", invalid="ignore"):
+                return _modal_rhs(t, y)
+
+        def _modal_rhs(t, y):
+            x, v = self.split(y)
+            q, qd = self.modes(y)
+            acc = np.tile(self.g, (len(m), 1))
+            modal_force = np.zeros(plate.n_modes)
+            if pairs:
+                kin, li, lj, is_plate, slope, phi = self.modal_kinematics(ix, x, v, (q, qd))
+                f = impact_force_in_region(kin.penetration, kin.rate, laws, ramp, clamped)
+                fn = f[:, None] * kin.normal
+                fn[:, :2] -= f[:, None] * slope  # zero slope for ball-ball pairs
+                np.add.at(acc, li, fn / m[li, None])
+                ball = ~is_plate
+                np.add.at(acc, lj[ball], -fn[ball] / m[lj[ball], None])
+                modal_force = -(f @ phi)
+            qdd = plate.acceleration(q, qd, modal_force)
+            return np.concatenate([v.ravel(), acc.ravel(), qd, qdd])
 
         return rhs
 
@@ -250,10 +360,12 @@ class _Reference:
                 else:
                     fresh, h0 = self.finish_redo(pending[0], solver.t, solver.y)
                 pending, t_bound = None, self.next_stop(duration)
+                self.h_cap = math.inf
                 solver = self.new_solver(self.t, self.y, t_bound, h0)
                 continue
             t0, y0 = solver.t, solver.y.copy()
-            message = solver.step()
+            with np.errstate(**self.trial_errors):  # (see make_modal_rhs)
+                message = solver.step()
             if solver.status == "failed":
                 raise RuntimeError(f"stream reference: DOP853 failed: {message}")
             self.steps += 1
@@ -263,6 +375,10 @@ class _Reference:
                     f"t = {t0:.6g} s; raise max_steps or shorten the duration"
                 )
             dense, t1 = solver.dense_output(), solver.t
+            if self.too_far(dense, t0, t1):  # modal plate: the step bound of the gap rows
+                self.h_cap = 0.5 * (t1 - t0)
+                solver = self.new_solver(t0, y0, t_bound, self.h_cap)
+                continue
             found = self.detect(dense, t0, t1, fresh)
             if found is not None and pending and found[1] >= pending[1] - SAME_TIME * (t1 - t0):
                 found = None  # (about) simultaneous with the pending event: taken after it
@@ -292,7 +408,8 @@ class _Reference:
         fresh set and the next first step."""
         x, v = self.split(y)
         key, sign, _, band = row
-        if sign * self.row_values([row], x[None], v[None])[0, 0] <= band:
+        modes = self.modes(y[None])
+        if sign * self.row_values([row], x[None], v[None], modes)[0, 0] <= band:
             return {key}, self.apply(key, t, y)
         self.t, self.y = t, y
         return set(), None
@@ -301,9 +418,23 @@ class _Reference:
         self.t, self.y = t, y
         n = len(self.active)  # atol: rtol x 1 mm on positions, rtol x 1 m/s on velocities
         atol = self.rtol * np.concatenate([np.full(3 * n, 1e-3), np.ones(3 * n)])
+        if self.plate is not None:
+            atol = np.concatenate([atol, self.plate.atol(self.rtol)])
         if h0 is not None:
             h0 = min(h0, t_bound - t) if t_bound > t else None
-        return DOP853(self.make_rhs(), t, y, t_bound, rtol=self.rtol, atol=atol, first_step=h0)
+        return DOP853(self.make_rhs(), t, y, t_bound, rtol=self.rtol, atol=atol, first_step=h0,
+                      max_step=self.h_cap)  # fmt: skip
+
+    def too_far(self, dense, t0, t1) -> bool:
+        """Modal plate: whether a ball moved more than 1 / k_max sideways on the step (k_max:
+        the top mode's wavenumber). Below it the mode shapes along the path are so smooth that
+        the 15-point interpolant of the plate gap rows is exact to round-off (module
+        docstring); the step is then redone shorter."""
+        if self.plate is None or t1 <= t0 or not self.active:
+            return False
+        x = self.states_at(dense, t0 + STEP_POINTS * (t1 - t0))[0]
+        travel = np.max(np.linalg.norm(x[:, :, :2] - x[:1, :, :2], axis=-1))
+        return bool(self.plate.k_max * travel > 1.0)
 
     # --- events ---------------------------------------------------------------------------
     def rows(self):
@@ -331,14 +462,15 @@ class _Reference:
                 rows.append(((EventKind.LEAVE, (b, e)), 1.0, True, 1e-13))
         return rows
 
-    def row_values(self, rows, x, v):
-        """Values of ``rows`` at the states x, v (K, n, 3): array (len(rows), K)."""
+    def row_values(self, rows, x, v, modes=None):
+        """Values of ``rows`` at the states x, v (K, n, 3) (and modes, each (K, m)): array
+        (len(rows), K)."""
         pair_keys = [r[0][1] for r in rows if r[0][0] != EventKind.LEAVE]
         pairs = [self.pairs[k] for k in dict.fromkeys(pair_keys)]
         index = {id(p): q for q, p in enumerate(pairs)}
         out = np.empty((len(rows), x.shape[0]))
         if pairs:
-            kin, _, _, _ = self.kinematics(pairs, x, v)
+            kin, _, _, _ = self.kinematics(pairs, x, v, modes)
             delta = kin.penetration.reshape(x.shape[0], len(pairs)).T
             rate = kin.rate.reshape(x.shape[0], len(pairs)).T
         loc = self.local()
@@ -362,17 +494,18 @@ class _Reference:
         return out
 
     def states_at(self, dense, times):
-        ys = np.atleast_2d(dense(times).T)  # (K, 6n)
+        """Positions, velocities (K, n, 3) and modes ((K, m) each, or None) at ``times``."""
+        ys = np.atleast_2d(dense(times).T)  # (K, 6n [+ 2m])
         n = len(self.active)
-        return ys[:, : 3 * n].reshape(-1, n, 3), ys[:, 3 * n :].reshape(-1, n, 3)
+        x, v = ys[:, : 3 * n].reshape(-1, n, 3), ys[:, 3 * n : 6 * n].reshape(-1, n, 3)
+        return x, v, self.modes(ys)
 
     def detect(self, dense, t0, t1, fresh):
         """Earliest (row, time) of an event on [t0, t1], or None."""
         rows = self.rows()
         if not rows or t1 <= t0:
             return None
-        x, v = self.states_at(dense, t0 + STEP_POINTS * (t1 - t0))
-        values = self.row_values(rows, x, v)
+        values = self.row_values(rows, *self.states_at(dense, t0 + STEP_POINTS * (t1 - t0)))
         # g = sign x value + band: positive on the row's side, its event where g < 0
         g = (
             np.array([r[1] for r in rows])[:, None] * values
@@ -409,8 +542,8 @@ class _Reference:
         k = int(change[0]) + 1
 
         def f(s):
-            x, v = self.states_at(dense, np.array([t0 + s * (t1 - t0)]))
-            return sign * self.row_values([row], x, v)[0, 0] + band
+            states = self.states_at(dense, np.array([t0 + s * (t1 - t0)]))
+            return sign * self.row_values([row], *states)[0, 0] + band
 
         return brentq(f, STEP_POINTS[k - 1], STEP_POINTS[k], xtol=1e-15, rtol=1e-15)
 
@@ -424,7 +557,7 @@ class _Reference:
             return None
         p = self.pairs[k]
         x, v = self.split(y)
-        kin, li, lj, _ = self.kinematics([p], x, v)
+        kin, li, lj, _ = self.kinematics([p], x, v, self.modes(y))
         if kind == EventKind.CONTACT_START:
             self.open_contact(p, t, kin, x[li[0]], v, li[0], lj[0])
             return self.first_contact_step(p, kin.rate[0])
@@ -458,9 +591,11 @@ class _Reference:
     def open_contact(self, p, t, kin, x_i, v, li, lj):
         p.in_contact, p.ramp, p.clamped = True, True, False
         p.peak, p.t_peak, p.pen = 0.0, math.nan, max(0.0, float(kin.penetration[0]))
+        if p.j < 0 and self.plate is not None and self.plate.frozen:
+            p.phi0 = self.plate.shapes_at(x_i[:2])[0]
         n = kin.normal[0]
         point = x_i - n * (self.balls[p.i].radius - 0.5 * max(kin.penetration[0], 0.0))
-        rate = float(kin.rate[0])
+        rate = float(kin.rate[0]) if p.j >= 0 or self.plate is None else float(-v[li] @ n)
         p.records = [
             ContactRecord(self.balls[p.i].name, self.partner_name(p), t, point[0], point[1],
                           float(-v[li] @ n), rate)
@@ -476,24 +611,27 @@ class _Reference:
     def close_contact(self, p, t, kin, v, li, lj, end):
         n = kin.normal[0]
         outs = [float(v[li] @ n)] + ([float(-v[lj] @ n)] if p.j >= 0 else [])
+        # approach speeds of a plate row: the ball's (as v_in, v_out), also on the modal plate
+        out = -float(kin.rate[0]) if p.j >= 0 or self.plate is None else outs[0]
         for rec, v_out in zip(p.records, outs, strict=True):
-            rec.t_end, rec.v_out, rec.approach_out, rec.end = t, v_out, -float(kin.rate[0]), end
+            rec.t_end, rec.v_out, rec.approach_out, rec.end = t, v_out, out, end
             rec.peak_force, rec.t_peak, rec.max_penetration = p.peak, p.t_peak, p.pen
-        p.in_contact, p.records = False, []
+        p.in_contact, p.records, p.phi0 = False, [], None
         self.log(t, EventKind.CONTACT_END, p)
 
     def leave(self, ball, edge, t):
         x, v = self.split(self.y)
+        modes = self.modes(self.y)
         for pk in [pk for pk in self.pairs if ball in pk]:
             p = self.pairs.pop(pk)
             if p.in_contact:
-                kin, li, lj, _ = self.kinematics([p], x, v)
+                kin, li, lj, _ = self.kinematics([p], x, v, modes)
                 self.close_contact(p, t, kin, v, li[0], lj[0], "left")
         self.leaves.append(LeaveEvent(self.balls[ball].name, t, edge))
         self.events.append((t, EventKind.LEAVE, self.balls[ball].name, edge))
         keep = [q for q, b in enumerate(self.active) if b != ball]
         self.active = [self.active[q] for q in keep]
-        self.y = np.concatenate([x[keep].ravel(), v[keep].ravel()])
+        self.y = self.join(x[keep], v[keep], modes)
 
     def next_stop(self, duration):
         """Where the integration must stop next: the next release time or the end."""
@@ -503,6 +641,7 @@ class _Reference:
         """Add the balls whose release time is t (their given state), with their pairs."""
         self.t, self.y = t, y
         x, v = self.split(y)
+        modes = self.modes(y)
         new = []
         while self.waiting and self.waiting[0][0] <= t:
             _, i = self.waiting.pop(0)
@@ -512,7 +651,7 @@ class _Reference:
             v = np.vstack([v, ball.velocity])
             new.extend(self.add_pairs(i))
             self.events.append((t, EventKind.RELEASE, ball.name, ""))
-        self.y = np.concatenate([x.ravel(), v.ravel()])
+        self.y = self.join(x, v, modes)
         self.touch(new, t)
         return None
 
@@ -535,7 +674,7 @@ class _Reference:
         static penetration)."""
         x, v = self.split(self.y)
         for p in pairs:
-            kin, li, lj, _ = self.kinematics([p], x, v)
+            kin, li, lj, _ = self.kinematics([p], x, v, self.modes(self.y))
             if kin.penetration[0] > 0.0:
                 self.open_contact(p, t, kin, x[li[0]], v, li[0], lj[0])
                 p.ramp = bool(kin.penetration[0] < p.law.penetration) or not p.kinked
@@ -560,9 +699,10 @@ class _Reference:
             if delta[q].max() >= 0.99 * p.pen:
                 p.pen = max(p.pen, interpolant_max(delta[q])[1])
 
-    def pair_forces(self, pairs, x, v):
-        """Force (N) and penetration (m) of ``pairs`` at states x, v (K, n, 3): (P, K) each."""
-        kin, _, _, _ = self.kinematics(pairs, x, v)
+    def pair_forces(self, pairs, x, v, modes=None):
+        """Force (N) and penetration (m) of ``pairs`` at states x, v (K, n, 3) (and modes):
+        (P, K) each."""
+        kin, _, _, _ = self.kinematics(pairs, x, v, modes)
         laws = _law_table(pairs)
         ramp = np.array([p.ramp for p in pairs])
         clamped = np.array([p.clamped for p in pairs])
@@ -578,9 +718,13 @@ class _Reference:
         m = self.mass[self.active]
         energy = 0.5 * float(np.sum(m[:, None] * v * v))
         energy += self.incline.potential_energy(m, x)
+        modes = self.modes(y)
+        if modes is not None:
+            energy += self.plate.energy(*modes)
+            modes = tuple(a[None] for a in modes)
         pairs = [p for p in self.pairs.values() if p.in_contact]
         if pairs:
-            kin, _, _, _ = self.kinematics(pairs, x[None], v[None])
+            kin, _, _, _ = self.kinematics(pairs, x[None], v[None], modes)
             energy += float(np.sum(elastic_energy(kin.penetration, _law_table(pairs))))
         return energy
 
@@ -590,6 +734,8 @@ class _Reference:
         x, v = self.split(y)
         names = tuple(self.balls[b].name for b in self.active)
         self.states.append((names, x.copy(), v.copy()))
+        if self.plate is not None:
+            self.plate_states.append(tuple(a.copy() for a in self.modes(y)))
 
     def finish(self):
         for p in self.pairs.values():
@@ -599,12 +745,15 @@ class _Reference:
     def result(self, duration):
         info = {
             "solver": f"stream reference: scipy DOP853 rtol={self.rtol:g}, restarted at kinks",
+            "plate": "rigid"
+            if self.plate is None
+            else f"modal, two-way: {self.plate.n_modes} modes, {self.plate.shapes} shapes",
             "duration": duration,
         }
         return StreamReferenceResult(
             tuple(b.name for b in self.balls), self.mass, self.contacts, self.leaves,
             self.events, np.array(self.times), np.array(self.energy), self.states,
-            self.steps, info,
+            self.steps, info, self.plate_states,
         )  # fmt: skip
 
 
@@ -628,6 +777,18 @@ def _same_switch(key, fresh) -> bool:
 def _law_table(pairs) -> _Laws:
     return _Laws(*(np.array([getattr(p.law, a) for p in pairs], dtype=float)
                    for a in ("stiffness", "exponent", "damping", "penetration")))  # fmt: skip
+
+
+def _check_modal_work(plate, duration, max_steps):
+    """The modes bound the steps: at least MODAL_STEPS_PER_PERIOD per period of the top mode
+    (measured 9-20 at rtol 1e-12); refuse a run that cannot fit max_steps before it starts."""
+    estimate = MODAL_STEPS_PER_PERIOD * duration * float(np.max(plate.omega)) / (2.0 * math.pi)
+    if estimate > max_steps:
+        raise WorkLimitError(
+            f"stream reference: the modal plate (top mode {np.max(plate.omega) / 2 / math.pi:.4g}"
+            f" Hz) needs at least ~{estimate:.3g} steps for {duration:g} s, above "
+            f"max_steps={max_steps}; raise max_steps, shorten the duration or keep fewer modes"
+        )
 
 
 def _release_times(release_times, n):
