@@ -13,7 +13,10 @@ and off:
 - "residual (before)": the residual compliance as before issue 9: static compliance over the
   Hertz disc minus the kept modes at the point (inconsistent load models);
 - "residual": one load model for both parts (point for Kirchhoff, Hertz disc for Mindlin);
-- "residual + sensor QS": also the truncated modes' quasi-static response at the sensor.
+- "residual + sensor QS": also the truncated modes' quasi-static response at the sensor;
+- "ritz tail + sensor QS": the solver's ``plate.tail = "ritz"`` (tail_modes "auto": Ritz
+  pseudo-modes of the truncated modes at the contact point, then the quasi-static residual of
+  the augmented basis), also at the shipped 200 steps/contact.
 
 Errors: the largest relative error of restitution, peak force, duration and maximum
 penetration ("contact"), and the relative L2 error of the 0-10 kHz sensor acceleration over the
@@ -34,18 +37,22 @@ import numpy as np
 from tailbeam.bodies import Ball, Plate
 from tailbeam.contact_law import ball_plate_law
 from tailbeam.coupled import records
-from tailbeam.coupled.fe_compare import Case, modal_errors, observed_order
+from tailbeam.coupled.fe_compare import RECORD_S, Case, modal_errors, observed_order
 from tailbeam.coupled.fe_reference import fe_time_step_study
+from tailbeam.coupled.ritz_prepass import ritz_tail_basis
 from tailbeam.hertz import hertz_max_penetration
 from tailbeam.materials import CARBON_STEEL, SANDSTONE
 from tailbeam.plate import assemble_plate, compute_modes
 from tailbeam.plate.resolution import resolve
+from tailbeam.progress import quiet
+from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
 
 R = 0.03
 IMPACT, SENSOR = (0.05, 0.03), (0.05, 0.10)
 BANDS = (10000.0, 14000.0, 20000.0, 28000.0, 40000.0)
 TEST_MESHES = {"kirchhoff": 8, "mindlin": 6}
 VARIANTS = ("no residual", "residual (before)", "residual", "residual + sensor QS")
+RITZ = "ritz tail + sensor QS"  # plate.tail = "ritz" (tailbeam.coupled.ritz_prepass)
 
 
 def _divisions(theory, full):
@@ -69,6 +76,16 @@ def _before(basis, ball, law):
     object.__setattr__(basis, "residual_compliance", residual_compliance)
     records._COMPLIANCE_CACHE.pop(basis, None)
     return basis
+
+
+def _ritz(basis, ball, theory):
+    """The basis plus the solver's Ritz tail (plate.tail = "ritz", tail_modes "auto") at the
+    ball's first contact point, as simulate_scene_modal builds it."""
+    modal = ModalPlateSettings(theory=theory, damping_ratio=0.0, tail="ritz")
+    scene = Scene((ball,), Plate(), ContactSettings(damping=0.0), duration=RECORD_S,
+                  plate_model="modal", modal=modal)  # fmt: skip
+    with quiet():
+        return ritz_tail_basis(scene, basis, "auto")[0]
 
 
 def study_theory(theory, full, dt, steps, bands=BANDS):
@@ -98,6 +115,9 @@ def study_theory(theory, full, dt, steps, bands=BANDS):
         old = modal_errors(case, _before(basis(), ball, law), ref, steps_per_contact=steps)
         new = modal_errors(case, basis(), ref, steps_per_contact=steps)
         default = modal_errors(case, basis(), ref)  # 200 steps per contact, as shipped
+        ritz_basis = _ritz(basis(), ball, theory)  # plate.tail = "ritz", tail_modes "auto"
+        ritz = modal_errors(case, ritz_basis, ref, steps_per_contact=steps)
+        ritz200 = modal_errors(case, ritz_basis, ref)
         n = new["n_modes"]
         rows += [
             (theory, band, n, VARIANTS[0], none["contact"], none["sensor_no_qs"]),
@@ -106,6 +126,9 @@ def study_theory(theory, full, dt, steps, bands=BANDS):
             (theory, band, n, VARIANTS[3], new["contact"], new["sensor"]),
             (theory, band, n, "default (200 steps/contact)", default["contact"],
              default["sensor"]),
+            (theory, band, ritz["n_modes"], RITZ, ritz["contact"], ritz["sensor"]),
+            (theory, band, ritz["n_modes"], f"{RITZ}, 200 steps/contact", ritz200["contact"],
+             ritz200["sensor"]),
         ]  # fmt: skip
         print(f"  {band:7.0f} Hz {n:4d} modes: contact {none['contact']:.2e} / "
               f"{old['contact']:.2e} / {new['contact']:.2e}; sensor {none['sensor_no_qs']:.2e}"
@@ -152,17 +175,23 @@ def plot(rows, out: Path):
 
     theories = sorted({r[0] for r in rows})
     fig, axes = plt.subplots(len(theories), 2, figsize=(10, 3.8 * len(theories)), squeeze=False)
-    styles = {VARIANTS[0]: "o:", VARIANTS[1]: "s--", VARIANTS[2]: "^-", VARIANTS[3]: "D-"}
+    styles = {VARIANTS[0]: "o:", VARIANTS[1]: "s--", VARIANTS[2]: "^-", VARIANTS[3]: "D-",
+              RITZ: "x-"}  # fmt: skip
     for i, theory in enumerate(theories):
         for j, (col, what) in enumerate(((4, "contact (max of 4 quantities)"),
                                          (5, "sensor, 0-10 kHz, first 3 ms"))):  # fmt: skip
             ax = axes[i, j]
-            for variant, style in styles.items():
+            for c, (variant, style) in enumerate(styles.items()):
                 if j == 0 and variant == VARIANTS[3]:
                     continue  # the sensor correction does not change the contact
                 sel = [r for r in rows if r[0] == theory and r[3] == variant]
-                ax.loglog([r[1] / 1000 for r in sel], [r[col] for r in sel], style,
-                          label=variant)  # fmt: skip
+                ax.loglog(
+                    [r[1] / 1000 for r in sel],
+                    [r[col] for r in sel],
+                    style,
+                    color=f"C{c}",
+                    label=variant,
+                )  # fmt: skip (one colour per variant)
             if j == 0:
                 ax.axhline(2e-5, color="grey", lw=0.8)
                 ax.text(10.2, 2.2e-5, "2e-5", color="grey", fontsize=8)

@@ -34,6 +34,7 @@ PLATE_MODELS = ("rigid", "modal")
 LABELS = ("coal", "gangue")
 THEORIES = ("auto", "kirchhoff", "mindlin")
 COUPLINGS = ("two-way", "one-way")
+TAILS = ("quasi-static", "ritz")
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,11 @@ class ModalPlateSettings:
     frequency kept (None: chosen from the scene). mesh_divisions: elements per side (None: auto).
     residual_flexibility: add the static compliance of the truncated modes at contacts.
     coupling: "two-way" or "one-way" (rigid-plate forces applied to the plate).
+    tail: how the truncated modes act at a contact: "quasi-static" (their static compliance)
+    or "ritz" (load-dependent Ritz pseudo-modes at the balls' first contact points,
+    tailbeam.coupled.ritz_prepass; needs residual_flexibility and two-way coupling).
+    tail_modes: Ritz pseudo-modes per contact point, "auto" (chosen per point) or a whole
+    number >= 1.
     """
 
     boundary: str = "SSSS"
@@ -85,6 +91,8 @@ class ModalPlateSettings:
     mesh_divisions: int | None = None
     residual_flexibility: bool = True
     coupling: str = "two-way"
+    tail: str = "quasi-static"
+    tail_modes: int | str = "auto"
 
     def __post_init__(self):
         code = self.boundary
@@ -116,6 +124,22 @@ class ModalPlateSettings:
             n = self.mesh_divisions
             if isinstance(n, bool) or not isinstance(n, int) or n < 1:
                 raise InputError("plate.mesh_divisions", f"must be a whole number >= 1, got {n!r}")
+        self._check_tail()
+
+    def _check_tail(self):
+        if self.tail not in TAILS:
+            raise InputError("plate.tail", f"must be one of {TAILS}, got {self.tail!r}")
+        k = self.tail_modes
+        if k != "auto" and (isinstance(k, bool) or not isinstance(k, int) or k < 1):
+            raise InputError(
+                "plate.tail_modes", f"must be 'auto' or a whole number >= 1, got {k!r}"
+            )
+        if self.tail == "ritz" and not (self.residual_flexibility and self.coupling == "two-way"):
+            raise InputError(
+                "plate.tail",
+                "'ritz' refines the residual flexibility of two-way coupling; it needs "
+                "residual_flexibility = true and coupling = 'two-way'",
+            )
 
 
 @dataclass(frozen=True)

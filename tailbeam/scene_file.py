@@ -63,6 +63,8 @@ MODAL_KEYS = (
     "mesh_divisions",
     "residual_flexibility",
     "coupling",
+    "tail",
+    "tail_modes",
 )
 BALL_KEYS = ("name", "material", "radius", "position", "velocity", "label")
 SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance", "noise")
@@ -223,7 +225,7 @@ def _parse_plate(table: dict, materials: dict):
     modal = None
     if model == "modal":
         m = {}
-        for key in ("boundary", "theory", "coupling"):
+        for key in ("boundary", "theory", "coupling", "tail"):
             if key in table:
                 m[key] = _string(f"plate.{key}", table[key])
         if "damping_ratio" in table:
@@ -238,6 +240,8 @@ def _parse_plate(table: dict, materials: dict):
             m["residual_flexibility"] = _bool(
                 "plate.residual_flexibility", table["residual_flexibility"]
             )
+        if "tail_modes" in table:
+            m["tail_modes"] = table["tail_modes"]  # "auto" or a whole number, checked there
         modal = ModalPlateSettings(**m)
     return plate, model, modal
 

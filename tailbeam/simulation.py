@@ -54,6 +54,9 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
     how = {k: v for k, v in (("rtol", rtol), ("max_steps", max_steps)) if v is not None}
     with contextlib.nullcontext() if progress else quiet():
         if scene.needs_stream_solver:
+            from tailbeam.coupled.ritz_prepass import check_tail_scene
+
+            check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
             band = stream_band(scene) if scene.plate_model == "modal" else None
             plate = _stream_plate(scene, band) if band and band["two_way"] else None
             result = _stream(scene, how, plate)

@@ -55,6 +55,12 @@ def modal_errors(case: Case, basis, ref, **options) -> dict:
     duration = float(ref.t[-1])
     res = simulate_coupled([case.ball], basis, [case.law], duration, gravity=case.gravity,
                            **options)  # fmt: skip
+    return dict(result_errors(case, res, ref), n_modes=basis.n_modes)
+
+
+def result_errors(case: Case, res, ref) -> dict:
+    """Relative errors of a coupled result ``res`` of ``case`` (however it was run, e.g. a
+    scene through simulate_scene_modal) against the reference ``ref``: as modal_errors."""
     q, q_ref = impact_quantities(res.impacts[0]), impact_quantities(ref.impacts[0])
     out = {name: abs(q[name] / q_ref[name] - 1.0) for name in QUANTITIES}
     out["contact"] = max(out[name] for name in QUANTITIES)
@@ -66,7 +72,6 @@ def modal_errors(case: Case, basis, ref, **options) -> dict:
     for key, qs in (("sensor", True), ("sensor_no_qs", False)):
         a = res.plate_sample(t, [case.sensor], quasi_static=qs)["a"][0]
         out[key] = relative_l2(in_band(t, a, SENSOR_BAND_HZ)[win], a_ref[win])
-    out["n_modes"] = basis.n_modes
     return out
 
 

@@ -14,8 +14,9 @@ ordinary extra modes (Rayleigh damping stays diagonal) with true plate shapes.
 Measured (docs/fe-convergence.md, "Many-node tails"): at a 20 kHz band, k = 16-32 per contact
 point brings the contact quantities of the test meshes to 2-7e-6 of the full FE solution
 (quasi-static residual 3.5e-5), k = 48-128 on the default Argyris 23x23 mesh. This module only
-builds them for load points known in advance (``with_ritz_tail``: one falling ball, the FE
-cross-checks); the coupled solver does not create them per contact.
+builds them for load points known in advance (``with_ritz_tail``: the FE cross-checks, and
+the coupled solver's pre-pass over the balls' first contact points with ``plate.tail =
+"ritz"``, tailbeam.coupled.ritz_prepass).
 """
 
 import numpy as np
@@ -27,6 +28,7 @@ from tailbeam.plate.model import check_points
 
 MAX_RITZ_VECTORS = 1024  # k x points: memory n_dofs x this x 8 B (250 MB at 30 000 DOFs)
 K_START = 16  # choose_ritz_k's first k (fewer ring coherently: docs/fe-convergence.md)
+DEFLECTION_MEMO = 32  # point sets whose deflections with_ritz_tail's basis keeps
 BREAKDOWN = 1e-10  # a new Krylov vector this small against its start is dropped (exhausted)
 
 
@@ -74,27 +76,36 @@ def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> M
 
     points: (p, 2) m, where the loads act (the contact points, known in advance);
     contact_radius: m, the load is 1 N spread over a disc of this radius (0: a point load;
-    use ``tailbeam.contact_patch.load_radius`` as the solver does). The pseudo-modes have
+    use ``tailbeam.contact_patch.load_radius`` as the solver does), one for every point or
+    a sequence of p, one per point (balls of different sizes). The pseudo-modes have
     their true shapes (seen at sensors and other points), and the residual compliance of the
     returned basis (static minus every mode it holds) is ~0 at the points. Raises InputError
     for bad input, WorkLimitError if k x points exceeds MAX_RITZ_VECTORS.
     """
     _check_basis(basis)
     _check_count("k", k, 1)
-    radius = require_nonnegative("contact_radius", contact_radius)
     pts = check_points(basis.plate, points)
+    radii = _radii(contact_radius, len(pts))
     if k * len(pts) > MAX_RITZ_VECTORS:
         raise WorkLimitError(
             f"{k} Ritz vectors x {len(pts)} points > {MAX_RITZ_VECTORS}; lower k or the points"
         )
     model = basis.fe_model()
-    loads = np.column_stack([model.load_vector(p, radius) for p in pts])
+    loads = np.column_stack([model.load_vector(p, r) for p, r in zip(pts, radii, strict=True)])
     omega, Z = ritz_tail_modes(basis, loads, int(k))
-    parent = basis.deflection_at
+    kept, seen = basis.mode_vectors, {}
 
     def deflection_at(at):
-        extra = model.deflection_operator(np.atleast_2d(at)) @ Z
-        return np.column_stack([np.asarray(parent(at)), extra])
+        # one mesh search for the kept and the Ritz modes, memoised: the solver asks again
+        # for the same contact or sensor points (each search ~10 ms on the 23x23 mesh)
+        at = np.atleast_2d(np.asarray(at, dtype=float))
+        key = at.tobytes()
+        if key not in seen:
+            if len(seen) >= DEFLECTION_MEMO:
+                seen.pop(next(iter(seen)))
+            op = model.deflection_operator(at)
+            seen[key] = np.column_stack([op @ kept, op @ Z])
+        return seen[key].copy()
 
     info = dict(basis.info, ritz_tail={"k": int(k), "points": pts.tolist(), "added": len(omega)})
     return ModalBasis(
@@ -107,6 +118,14 @@ def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> M
         basis.static_deflection_at,
         info,
     )
+
+
+def _radii(contact_radius, n: int) -> list:
+    """n load radii (m) from one radius or a sequence of n, else InputError."""
+    radii = np.asarray(contact_radius, dtype=float).ravel()
+    if radii.size not in (1, n):
+        raise InputError("contact_radius", f"must be one radius or {n}, one per point")
+    return [require_nonnegative("contact_radius", float(r)) for r in np.resize(radii, n)]
 
 
 def _check_basis(basis):

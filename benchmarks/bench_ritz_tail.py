@@ -1,0 +1,197 @@
+"""Cost and accuracy of ``plate.tail = "ritz"`` beside the quasi-static tail (the baseline), in
+the same run, through the scene path (``simulate_scene_modal``, default 200 steps/contact).
+
+    python benchmarks/bench_ritz_tail.py [--out DIR] [--cases test default sweep]
+
+Cases (each run with tail = "quasi-static" and "ritz", tail_modes auto; default and sweep
+also with tail_modes = 32 and 64, which skip the choice of k):
+- test: the FE test case of tests/test_coupled_fe.py (Argyris 8x8, 20 kHz, sandstone 30 mm at
+  1 m/s, no damping, 0.6 ms); truth: the full-FE reference (Newmark, 1e-7 s, ~7 s).
+- default: the same impact on the default Argyris 23x23 mesh (4805 DOFs) at 20 kHz; cost only
+  (its FE reference takes ~10 min: docs/fe-convergence.md has the errors).
+- sweep: the base case of benchmarks/bench_sweep.py (examples/single_impact_base.toml: SSSS,
+  fmax 5 kHz, auto mesh = Mindlin P4 12x12, coal 30 mm at 2 m/s, 25 ms, sensor at
+  12.8 kHz, 1 % damping); truth: the same scene at fmax 40 kHz with tail = "ritz"
+  (its difference to 40 kHz quasi-static is reported as the truth's own uncertainty).
+Reported: the Ritz pre-pass time (choose k per point + build), k, modes, the run time (best of
+3, numba warm), the first impact's contact errors (restitution, peak force, duration,
+max penetration; max of the four) and the in-band sensor error (relative L2, 0-10 kHz for
+test, 0-5 kHz for sweep). Timings on a shared machine are noisy. Writes DIR/table.md.
+"""
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from tailbeam.bodies import Ball, Plate
+from tailbeam.coupled.auto import build_basis, choose_band, simulate_scene_modal
+from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities, in_band, relative_l2
+from tailbeam.materials import SANDSTONE
+from tailbeam.progress import quiet
+from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
+from tailbeam.scene_file import load_scene
+
+ROOT = Path(__file__).parents[1]
+TAILS = ("quasi-static", "ritz")
+FIXED_K = (32, 64)  # also run with plate.tail_modes set (no choose_ritz_k) on default/sweep
+
+
+def _variants():
+    """(tail, extra ModalPlateSettings) of the compared runs: the baseline, auto, fixed k."""
+    return [("quasi-static", {}), ("ritz", {})] + [("ritz", {"tail_modes": k}) for k in FIXED_K]
+
+
+def _with_tail(scene, tail, **modal):
+    m = scene.modal
+    fields = {k: getattr(m, k) for k in m.__dataclass_fields__}
+    return Scene(scene.balls, scene.plate, scene.contact, duration=scene.duration,
+                 plate_model="modal", modal=ModalPlateSettings(**{**fields, **modal, "tail": tail}),
+                 sensors=scene.sensors, gravity=scene.gravity)  # fmt: skip
+
+
+def _impact_scene(divisions, duration=6e-4):
+    ball = Ball("b", SANDSTONE, 0.03, (0.05, 0.03, 0.03001), (0.0, 0.0, -1.0))
+    modal = ModalPlateSettings(theory="kirchhoff", damping_ratio=0.0, fmax_hz=20000.0,
+                               mesh_divisions=divisions)  # fmt: skip
+    return Scene((ball,), Plate(), ContactSettings(damping=0.0), duration=duration,
+                 plate_model="modal", modal=modal)  # fmt: skip
+
+
+def _run(scene, basis, repeats=3):
+    """(result, best run time s, pre-pass s): the pre-pass is timed once (first call)."""
+    best, first = np.inf, None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        with quiet():
+            res = simulate_scene_modal(scene, basis=basis)
+        elapsed = time.perf_counter() - t0
+        build = res.info.get("tail", {}).get("build_s", 0.0)
+        first = build if first is None else first
+        best = min(best, elapsed - build)
+    return res, best, first
+
+
+def _contact_errors(res, q_ref) -> dict:
+    q = impact_quantities(res.impacts[0])
+    out = {n: abs(q[n] / q_ref[n] - 1.0) for n in QUANTITIES}
+    out["contact"] = max(out.values())
+    return out
+
+
+def _sensor_error(res, t, a_ref, point, band_hz):
+    a = res.plate_sample(t, [point])["a"][0]
+    return relative_l2(in_band(t, a, band_hz), a_ref)
+
+
+def case_test():
+    sys.path.insert(0, str(ROOT / "tests"))
+    from test_coupled_fe import _basis, _case
+
+    case = _case("kirchhoff")
+    ref = case.reference(1e-7)
+    scene = _impact_scene(8, duration=float(ref.t[-1]))
+    basis = _basis("kirchhoff", fmax_hz=20000.0)
+    q_ref = impact_quantities(ref.impacts[0])
+    a_ref = in_band(ref.t, ref.sensor_a[0], 10_000.0)
+    win = ref.t <= 3e-3
+    rows = []
+    for tail in TAILS:
+        res, run_s, build_s = _run(_with_tail(scene, tail), basis)
+        err = _contact_errors(res, q_ref)
+        a = in_band(ref.t, res.plate_sample(ref.t, [case.sensor])["a"][0], 10_000.0)
+        err["sensor"] = relative_l2(a[win], a_ref[win])
+        rows.append(_row("test (8x8, 20 kHz)", tail, res, basis, run_s, build_s, err))
+    return rows
+
+
+def case_default():
+    scene = _impact_scene(None)
+    t0 = time.perf_counter()
+    basis = build_basis(scene, choose_band(scene))
+    print(f"default basis: {basis.info.get('divisions')} divisions, {basis.n_modes} modes, "
+          f"{time.perf_counter() - t0:.1f} s (cache {basis.info.get('cache')})")  # fmt: skip
+    rows = []
+    for tail, extra in _variants():
+        res, run_s, build_s = _run(_with_tail(scene, tail, **extra), basis)
+        rows.append(_row("default (23x23, 20 kHz)", tail, res, basis, run_s, build_s, {}))
+    return rows
+
+
+def case_sweep():
+    base = load_scene(ROOT / "examples" / "single_impact_base.toml")
+    base = Scene(
+        base.balls,
+        base.plate,
+        base.contact,
+        duration=base.duration,
+        plate_model="modal",
+        modal=base.modal,
+        gravity=base.gravity,
+    )  # fmt: skip (no noisy sensor)
+    point = (0.1, 0.15)
+    truth_scene = _with_tail(base, "ritz", fmax_hz=40000.0)
+    basis = build_basis(base, choose_band(base))
+    divisions = basis.info.get("divisions")
+    truth_scene = _with_tail(truth_scene, "ritz", mesh_divisions=divisions, theory=basis.theory)
+    truth_basis = build_basis(truth_scene, choose_band(truth_scene))
+    truth, _, _ = _run(truth_scene, truth_basis, repeats=1)
+    truth_qs, _, _ = _run(_with_tail(truth_scene, "quasi-static"), truth_basis, repeats=1)
+    t = np.arange(0.0, base.duration, 1.0 / 51200.0)
+    a_ref = in_band(t, truth.plate_sample(t, [point])["a"][0], 5000.0)
+    q_ref = impact_quantities(truth.impacts[0])
+    uncertainty = _contact_errors(truth_qs, q_ref)["contact"]
+    print(f"sweep truth: {truth_basis.n_modes} modes at 40 kHz ({basis.theory}, {divisions} "
+          f"divisions); 40 kHz quasi-static vs ritz: {uncertainty:.1e}")  # fmt: skip
+    rows = []
+    for tail, extra in _variants():
+        res, run_s, build_s = _run(_with_tail(base, tail, **extra), basis)
+        err = _contact_errors(res, q_ref)
+        err["sensor"] = _sensor_error(res, t, a_ref, point, 5000.0)
+        rows.append(_row("sweep base (5 kHz, 25 ms)", tail, res, basis, run_s, build_s, err))
+    return rows
+
+
+def _row(case, tail, res, basis, run_s, build_s, err):
+    info = res.info.get("tail", {})
+    if info.get("tail_modes", "auto") != "auto":
+        tail = f"{tail}, tail_modes = {info['tail_modes']}"
+    return {"case": case, "tail": tail, "k": info.get("k", "-"),
+            "modes": res.basis.n_modes, "prepass_s": build_s, "run_s": run_s,
+            "contact": err.get("contact"), "sensor": err.get("sensor")}  # fmt: skip
+
+
+def _fmt(v, spec):
+    return "-" if v is None else format(v, spec)
+
+
+def main(out_dir="out/benchmarks/bench_ritz_tail", cases=("test", "default", "sweep")):
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for name in cases:
+        rows += {"test": case_test, "default": case_default, "sweep": case_sweep}[name]()
+    lines = [
+        "| case | tail | k | modes | Ritz pre-pass s | run s (best of 3) | contact error | "
+        "sensor error |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['case']} | {r['tail']} | {r['k']} | {r['modes']} | {r['prepass_s']:.3f} | "
+            f"{r['run_s']:.3f} | {_fmt(r['contact'], '.2e')} | {_fmt(r['sensor'], '.2e')} |"
+        )
+    text = "\n".join(lines) + "\n"
+    (out / "table.md").write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default="out/benchmarks/bench_ritz_tail")
+    parser.add_argument("--cases", nargs="+", default=["test", "default", "sweep"],
+                        choices=["test", "default", "sweep"])  # fmt: skip
+    args = parser.parse_args()
+    main(args.out, args.cases)

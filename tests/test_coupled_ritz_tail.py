@@ -1,0 +1,203 @@
+"""``plate.tail = "ritz"``: the coupled solver with Ritz pseudo-modes at the balls' first
+contact points (tailbeam.coupled.ritz_prepass), against the full-FE reference of
+tests/test_coupled_fe.py (same meshes, ball, sensor), plus the scene key and its bad input."""
+
+import math
+
+import pytest
+from test_cli import tailbeam
+from test_coupled_fe import IMPACT, MESHES, SENSOR, R, _basis, runs  # noqa: F401 (fixture)
+
+import tailbeam as tb
+from tailbeam.bodies import Ball, Plate
+from tailbeam.coupled.auto import simulate_scene_modal
+from tailbeam.coupled.fe_compare import result_errors
+from tailbeam.coupled.ritz_prepass import first_contact_time, first_contacts, ritz_tail_basis
+from tailbeam.errors import InputError, WorkLimitError
+from tailbeam.materials import SANDSTONE
+from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
+from tailbeam.scene_file import loads_scene, scene_to_dict
+
+BAND = 20000.0
+
+
+def _scene(balls, duration=1e-3, **modal):
+    """The test-mesh scene of test_coupled_fe: SSSS, 20 kHz, no plate or contact damping."""
+    modal = {"damping_ratio": 0.0, "fmax_hz": BAND, "tail": "ritz", **modal}
+    modal.setdefault("mesh_divisions", MESHES[modal.get("theory", "kirchhoff")])
+    return Scene(tuple(balls), Plate(), ContactSettings(damping=0.0), duration=duration,
+                 plate_model="modal", modal=ModalPlateSettings(**modal))  # fmt: skip
+
+
+def test_first_contact_points_follow_the_free_fall():
+    # The lowest point gap + vz t - g t^2 / 2 reaches 0 at t_hit, where the ball is at
+    # (x0 + vx t_hit, y0 + vy t_hit); a vertical drop lands under its start.
+    g = 9.80665
+    drop = Ball("drop", SANDSTONE, R, (0.1, -0.2, R + 0.05), (0.0, 0.0, 0.0))
+    thrown = Ball("thrown", SANDSTONE, R, (-0.2, 0.1, R + 0.2), (0.3, -0.2, 1.0))
+    off = Ball("off", SANDSTONE, R, (0.28, 0.0, R + 0.2), (2.0, 0.0, 0.0))  # lands past x = 0.3
+    late = Ball("late", SANDSTONE, R, (0.0, 0.0, R + 3.0), (0.0, 0.0, 0.0))  # after duration
+    scene = _scene([drop, thrown, off, late], duration=0.5)
+    hits = {c["ball"]: c for c in first_contacts(scene, "kirchhoff")}
+    assert sorted(hits) == ["drop", "thrown"]
+    assert hits["drop"]["point"] == (0.1, -0.2)
+    t = first_contact_time(0.2, 1.0, g)
+    assert abs(0.2 + 1.0 * t - 0.5 * g * t * t) < 1e-15 and t > 0.0
+    assert hits["thrown"]["point"] == pytest.approx((-0.2 + 0.3 * t, 0.1 - 0.2 * t), abs=1e-15)
+    assert hits["thrown"]["speed"] == pytest.approx(math.sqrt(1.0 + 2 * g * 0.2), rel=1e-14)
+    assert first_contact_time(0.1, -2.0, 0.0) == pytest.approx(0.05)
+    assert first_contact_time(0.1, 2.0, 0.0) == math.inf
+
+
+@pytest.mark.parametrize("theory", ["kirchhoff", "mindlin"])
+def test_ritz_tail_scene_reaches_the_fe_reference_at_20_khz(runs, theory):  # noqa: F811
+    # Issue 9: 2e-5 on restitution, peak force, duration and max penetration at 20 kHz with
+    # the default 200 steps/contact. Measured: Kirchhoff 8x8 1.64e-5, Mindlin 6x6 1.66e-5
+    # (auto k = 32 on both; the rest is the time step's +1.6e-5 on the restitution), where
+    # the quasi-static tail gives 3.0e-5 on both (test_coupled_fe). In-band sensor (0-10
+    # kHz): measured 1.09e-4 / 1.26e-4 (quasi-static 2.7e-4 / 2.0e-4); the issue's bound
+    # is 1.5e-3.
+    case, ref = runs(theory)
+    scene = _scene([case.ball], duration=float(ref.t[-1]), theory=theory)
+    assert scene.laws() == (case.law,)
+    basis = _basis(theory, fmax_hz=BAND)
+    res = simulate_scene_modal(scene, basis=basis)
+    err = result_errors(case, res, ref)
+    assert err["contact"] < 2e-5, err
+    assert err["sensor"] < 2e-4, err
+    tail = res.info["tail"]
+    assert tail["k"] == 32 and tail["k_per_point"] == [32] and tail["added_modes"] == 32
+    assert res.basis.n_modes == basis.n_modes + 32
+    assert tail["load_radii_m"] == [case.load_radius]
+
+
+@pytest.mark.parametrize("theory", ["kirchhoff", "mindlin"])
+def test_no_double_counting_at_the_sensor(theory):
+    # The sensors' quasi-static correction is the residual of the AUGMENTED basis (static
+    # minus every mode held, the Ritz modes included): the Ritz modes span the contact's
+    # static residual K^-1 f - sum phi phi^T f / omega^2 (their first Krylov vector), so what
+    # is left at the contact and at the sensor is the round-off of "static minus the modal
+    # sum" (measured 1.5e-7 of the quasi-static residual), not that residual a second time.
+    ball = Ball("b", SANDSTONE, R, (*IMPACT, R + 1e-5), (0.0, 0.0, -1.0))
+    basis = _basis(theory, fmax_hz=BAND)
+    augmented, _ = ritz_tail_basis(_scene([ball], theory=theory), basis, 8)
+    radius = first_contacts(_scene([ball], theory=theory), theory)[0]["radius"]
+    assert (radius > 0.0) == (theory == "mindlin")  # a point load, or the Mindlin disc
+    before = basis.residual_cross_compliance(IMPACT, [SENSOR, IMPACT], radius)
+    after = augmented.residual_cross_compliance(IMPACT, [SENSOR, IMPACT], radius)
+    assert abs(after).max() < 1e-6 * abs(before).max(), (before, after)
+    assert augmented.residual_compliance([IMPACT], radius)[0] < 1e-6 * before[1]
+    # a later contact elsewhere keeps the quasi-static residual of the augmented basis: still
+    # there (the Ritz modes are local to the first point: measured 0.97 of it), never more
+    other = [(-0.2, 0.15)]
+    kept, aug = (
+        basis.residual_compliance(other, radius),
+        augmented.residual_compliance(other, radius),
+    )
+    assert 0.8 * kept[0] < aug[0] <= kept[0], (kept, aug)
+
+
+SCENE = """
+duration = 0.0008
+[contact]
+damping = 0.0
+[plate]
+model = "modal"
+theory = "kirchhoff"
+mesh_divisions = 8
+fmax = 20000
+tail = "ritz"
+[[balls]]
+name = "a"
+material = "sandstone"
+radius = 0.03
+position = [0.05, 0.03, 0.03001]
+velocity = [0.0, 0.0, -1.0]
+"""
+
+
+def test_scene_key_end_to_end(capsys):
+    scene = loads_scene(SCENE)
+    assert scene.modal.tail == "ritz" and scene.modal.tail_modes == "auto"
+    assert loads_scene(SCENE.replace('tail = "ritz"', 'tail = "ritz"\ntail_modes = 16')).modal == (
+        ModalPlateSettings(
+            theory="kirchhoff", mesh_divisions=8, fmax_hz=BAND, tail="ritz", tail_modes=16
+        )  # fmt: skip
+    )
+    assert scene_to_dict(scene)["plate"]["tail"] == "ritz"
+    assert "tail" not in scene_to_dict(loads_scene(SCENE.replace('tail = "ritz"', "")))["plate"]
+    res = tb.simulate(scene)
+    assert res.info["tail"]["k"] == 32 and res.info["tail"]["points"] == 1
+    assert len(res.impacts) == 1
+    err = capsys.readouterr().err
+    assert "Ritz tail: k = 32 (auto" in err and "Ritz tail k = 32, +32 modes" in err
+
+
+@pytest.mark.parametrize(
+    "new, field, rule_part",
+    [
+        ('tail = "cubic"', "plate.tail", "one of"),
+        ('tail = "ritz"\ntail_modes = 0', "plate.tail_modes", ">= 1"),
+        ('tail = "ritz"\ntail_modes = 2.5', "plate.tail_modes", "whole number"),
+        ('tail = "ritz"\ntail_modes = "many"', "plate.tail_modes", "'auto'"),
+        ('tail = "ritz"\nresidual_flexibility = false', "plate.tail", "residual_flexibility"),
+        ('tail = "ritz"\ncoupling = "one-way"', "plate.tail", "two-way"),
+    ],
+)
+def test_bad_tail_settings_name_the_field(new, field, rule_part):
+    with pytest.raises(InputError) as info:
+        loads_scene(SCENE.replace('tail = "ritz"', new))
+    assert info.value.field == field and rule_part in info.value.rule
+    assert "\n" not in str(info.value)
+
+
+def test_ritz_needs_an_fe_basis_and_the_coupled_solver():
+    ball = Ball("b", SANDSTONE, R, (*IMPACT, R + 1e-5), (0.0, 0.0, -1.0))
+    with pytest.raises(InputError, match=r"^plate\.tail: .*closed form"):
+        ritz_tail_basis(_scene([ball]), ssss_kirchhoff_basis(Plate(), BAND))
+    inclined = Scene((ball,), Plate(), plate_model="modal", inclination=10.0,
+                     modal=ModalPlateSettings(tail="ritz"))  # fmt: skip
+    with pytest.raises(InputError, match=r"^plate\.tail: .*stream solver"):
+        tb.simulate(inclined, progress=False)
+
+
+@pytest.mark.parametrize(
+    "new, field, error",
+    [
+        ('tail = "cubic"', "plate.tail", "plate.tail:"),
+        ('tail = "ritz"\ntail_modes = -3', "plate.tail_modes", "plate.tail_modes:"),
+        ('tail = "ritz"\ntail_modes = 2000', "plate.tail_modes", "2000 Ritz modes x 1"),
+    ],
+)
+def test_cli_bad_tail_exit_2_one_line_no_output(tmp_path, new, field, error):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SCENE.replace('tail = "ritz"', new))
+    out = tmp_path / "out"
+    proc = tailbeam("simulate", bad, "--out", out)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert field in lines[0] and error in lines[0] and "Traceback" not in proc.stderr
+    assert not out.exists()
+
+
+def test_work_limit_before_the_basis_is_built():
+    balls = [Ball(f"b{i}", SANDSTONE, 0.01, (-0.25 + 0.025 * i, 0.0, 0.02), (0.0, 0.0, 0.0))
+             for i in range(20)]  # fmt: skip
+    scene = _scene(balls, duration=0.1, tail_modes=64, mesh_divisions=200)  # never built
+    with pytest.raises(WorkLimitError, match=r"^plate\.tail_modes: 64 Ritz modes x 20"):
+        simulate_scene_modal(scene)
+
+
+def test_augmented_basis_keeps_the_kept_shapes_and_repeats_itself():
+    # one mesh search serves the kept and the Ritz modes (memoised): the kept modes' shapes
+    # are the parent basis' own (measured 2e-16 relative), a repeated call gives the same
+    basis = _basis("mindlin", fmax_hz=BAND)
+    ball = Ball("b", SANDSTONE, R, (*IMPACT, R + 1e-5), (0.0, 0.0, -1.0))
+    augmented, _ = ritz_tail_basis(_scene([ball], theory="mindlin"), basis, 4)
+    pts = [SENSOR, (-0.2, 0.13), (0.3, 0.0)]
+    first = augmented.deflection(pts)
+    kept = basis.deflection(pts)
+    assert abs(first[:, : basis.n_modes] - kept).max() < 1e-12 * abs(kept).max()
+    first[:] = 0.0  # the caller's copy: the memo is not changed through it
+    assert abs(augmented.deflection(pts)[:, : basis.n_modes] - kept).max() < 1e-12 * abs(kept).max()
