@@ -4,5 +4,19 @@ never come from (or go to) a user's ~/.cache/tailbeam and every run measures col
 import os
 import tempfile
 
+import pytest
+
 _CACHE = tempfile.mkdtemp(prefix="tailbeam-test-cache-")
 os.environ["TAILBEAM_CACHE_DIR"] = _CACHE
+
+
+@pytest.fixture(autouse=True)
+def _progress_not_quiet():
+    """Every test starts with tailbeam.progress speaking: an in-process CLI call with -q sets
+    it quiet for the process, which made later progress tests depend on how pytest-xdist
+    split the suite."""
+    from tailbeam.progress import set_quiet
+
+    set_quiet(False)
+    yield
+    set_quiet(False)
