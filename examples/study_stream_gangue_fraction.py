@@ -6,7 +6,8 @@ A caving stream of coal and sandstone lumps (radius uniform 10-40 mm, 100 per se
 arrivals, released 0.3-0.8 m above a 0.4 x 0.4 m area on the upper part of the plate) falls
 on the tail beam, inclined 30 degrees (a smaller examples/caving_stream.toml: SSSS plate,
 modes to 5 kHz, contact damping 300 N s/m). The stream solver finds every ball-ball and
-ball-plate contact, the plate's modes taking part (two-way, docs/streams.md). One accelerometer at (0.1, 0) m samples at 12.8 kHz (5 kHz bandwidth).
+ball-plate contact, the plate's modes taking part (two-way, docs/streams.md). One
+accelerometer at (0.1, 0) m samples at 12.8 kHz (5 kHz bandwidth).
 
 Each case has its own gangue fraction (the probability that a lump is gangue, uniform 0-0.5)
 and its own particles (the sweep seeds every stream from the case seed). The 3 s record is
