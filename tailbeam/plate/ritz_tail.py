@@ -44,31 +44,64 @@ def ritz_tail_modes(basis, loads, k: int):
     Returns omega (m,) rad/s ascending and Z (n_dofs, m), Z^T M Z = I, Z^T K Z = diag(omega^2),
     Phi_kept^T M Z = 0.
     """
-    model, kept = basis.fe_model(), basis.mode_vectors
-    M, solve = model.mass, model.solver().solve
-    loads = np.asarray(loads, dtype=float).reshape(kept.shape[0], -1)
-    V = np.zeros((kept.shape[0], k * loads.shape[1]))
-    count, block = 0, solve(loads)
-    for _ in range(k):
-        fresh = []
-        for u in block.T:
-            start = np.sqrt(u @ (M @ u))
-            for _ in range(2):  # twice is enough (Kahan-Parlett)
-                u = u - kept @ (kept.T @ (M @ u))
-                u = u - V[:, :count] @ (V[:, :count].T @ (M @ u))
-            norm = np.sqrt(u @ (M @ u))
-            if norm > BREAKDOWN * start:
-                V[:, count] = u / norm
-                fresh.append(count)
-                count += 1
-        if not fresh:
-            break
-        block = solve(M @ V[:, fresh])
-    if count == 0:  # the loads move no truncated mode
-        return np.zeros(0), V[:, :0]
-    V = V[:, :count]
-    theta, Y = eigh(V.T @ (model.stiffness @ V), V.T @ (M @ V))
-    return np.sqrt(theta), V @ Y
+    return KrylovTail(basis, loads).modes(k)
+
+
+class KrylovTail:
+    """The block Krylov space of K^-1 M started from ``loads``' static residual, M-orthogonal
+    to ``basis``' kept modes, grown step by step: the space of k steps is the start of the
+    space of 2k steps (the same vectors, bit for bit), so trying k = 16, 32, 64, ... costs one
+    build to the largest k, not the sum (``choose_ritz_k``)."""
+
+    def __init__(self, basis, loads):
+        self.model, self.kept = basis.fe_model(), basis.mode_vectors
+        self.loads = np.asarray(loads, dtype=float).reshape(self.kept.shape[0], -1)
+        self.buf = np.zeros((self.kept.shape[0], 16 * self.loads.shape[1]))
+        self.count = 0  # columns of buf in use
+        self.ends = [0]  # columns in use after each Krylov step
+        self.block = None  # the next step's vectors, before orthogonalisation
+        self.exhausted = False
+
+    def extend(self, k: int) -> None:
+        """Grow the space to k Krylov steps (or until it is exhausted)."""
+        M, solve = self.model.mass, self.model.solver().solve
+        if self.block is None:
+            self.block = solve(self.loads)
+        while len(self.ends) - 1 < k and not self.exhausted:
+            fresh = [self._add(u, M) for u in self.block.T]
+            fresh = [c for c in fresh if c is not None]
+            self.ends.append(self.count)
+            if not fresh:
+                self.exhausted = True
+                break
+            self.block = solve(M @ self.buf[:, fresh])
+
+    def _add(self, u, M):
+        """Orthogonalise u (twice is enough: Kahan-Parlett) and append it; its column, or
+        None when it breaks down."""
+        start = np.sqrt(u @ (M @ u))
+        V, kept = self.buf[:, : self.count], self.kept
+        for _ in range(2):
+            u = u - kept @ (kept.T @ (M @ u))
+            u = u - V @ (V.T @ (M @ u))
+        norm = np.sqrt(u @ (M @ u))
+        if norm <= BREAKDOWN * start:
+            return None
+        if self.count == self.buf.shape[1]:  # room doubles: copies stay O(final size)
+            self.buf = np.hstack([self.buf, np.zeros_like(self.buf)])
+        self.buf[:, self.count] = u / norm
+        self.count += 1
+        return self.count - 1
+
+    def modes(self, k: int):
+        """(omega rad/s ascending, Z): Rayleigh-Ritz on (K, M) over the first k steps."""
+        self.extend(k)
+        count = self.ends[min(k, len(self.ends) - 1)]
+        if count == 0:  # the loads move no truncated mode
+            return np.zeros(0), self.buf[:, :0]
+        V = self.buf[:, :count]
+        theta, Y = eigh(V.T @ (self.model.stiffness @ V), V.T @ (self.model.mass @ V))
+        return np.sqrt(theta), V @ Y
 
 
 def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> ModalBasis:
@@ -168,8 +201,10 @@ def choose_ritz_k(basis, point, contact_radius, duration, peak_force, max_penetr
     load = model.load_vector(check_points(basis.plate, point)[0], contact_radius)[:, None]
     t = np.linspace(0.0, duration, 4001)
 
+    krylov = KrylovTail(basis, load)  # grown once: k, 2k, 4k ... share its first vectors
+
     def response(k):
-        omega, Z = ritz_tail_modes(basis, load, k)
+        omega, Z = krylov.modes(k)
         return half_sine_response(omega, (load.T @ Z)[0], duration, peak_force, t)
 
     k, w_k = K_START, response(K_START)
