@@ -27,6 +27,7 @@ import time
 from tailbeam.contact_patch import load_radius
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.plate import ritz_tail
 from tailbeam.plate.ritz_tail import K_START, MAX_RITZ_VECTORS, choose_ritz_k, with_ritz_tail
 from tailbeam.progress import note, task
 
@@ -79,12 +80,12 @@ def _unique(contacts) -> list:
 
 
 def _check_basis(basis) -> None:
-    if getattr(basis, "mode_vectors", None) is None or not hasattr(basis, "fe_model"):
-        raise InputError(
-            "plate.tail",
-            f"'ritz' needs the FE modes and model; the {basis.theory} {basis.boundary} basis "
-            "has none (closed form); set plate.tail = 'quasi-static'",
-        )
+    ritz_tail.check_fe_basis(
+        basis,
+        "plate.tail",
+        f"'ritz' needs the FE modes and model; the {basis.theory} {basis.boundary} basis "
+        "has none (closed form); set plate.tail = 'quasi-static'",
+    )
 
 
 def _auto_k(basis, points) -> tuple[int, list]:

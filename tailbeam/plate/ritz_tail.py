@@ -30,6 +30,7 @@ MAX_RITZ_VECTORS = 1024  # k x points: memory n_dofs x this x 8 B (250 MB at 30 
 K_START = 16  # choose_ritz_k's first k (fewer ring coherently: docs/fe-convergence.md)
 DEFLECTION_MEMO = 32  # point sets whose deflections with_ritz_tail's basis keeps
 BREAKDOWN = 1e-10  # a new Krylov vector this small against its start is dropped (exhausted)
+KRYLOV_MEMO = 2  # Krylov spaces kept (the last loads): choose_ritz_k's space serves the build
 
 
 def ritz_tail_modes(basis, loads, k: int):
@@ -44,7 +45,23 @@ def ritz_tail_modes(basis, loads, k: int):
     Returns omega (m,) rad/s ascending and Z (n_dofs, m), Z^T M Z = I, Z^T K Z = diag(omega^2),
     Phi_kept^T M Z = 0.
     """
-    return KrylovTail(basis, loads).modes(k)
+    return krylov_tail(basis, loads).modes(k)
+
+
+_KRYLOV: dict = {}  # (id(basis), loads bytes) -> (basis, KrylovTail), the last KRYLOV_MEMO
+
+
+def krylov_tail(basis, loads) -> "KrylovTail":
+    """The Krylov space of ``loads`` on ``basis``, shared by the calls that ask for the same
+    loads (choose_ritz_k grows it to 2k; the build with k then only projects it)."""
+    loads = np.asarray(loads, dtype=float)
+    key = (id(basis), loads.shape, loads.tobytes())
+    hit = _KRYLOV.get(key)
+    if hit is None or hit[0] is not basis:
+        while len(_KRYLOV) >= KRYLOV_MEMO:
+            _KRYLOV.pop(next(iter(_KRYLOV)))
+        hit = _KRYLOV[key] = (basis, KrylovTail(basis, loads))
+    return hit[1]
 
 
 class KrylovTail:
@@ -115,7 +132,7 @@ def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> M
     returned basis (static minus every mode it holds) is ~0 at the points. Raises InputError
     for bad input, WorkLimitError if k x points exceeds MAX_RITZ_VECTORS.
     """
-    _check_basis(basis)
+    check_fe_basis(basis)
     _check_count("k", k, 1)
     pts = check_points(basis.plate, points)
     radii = _radii(contact_radius, len(pts))
@@ -161,9 +178,12 @@ def _radii(contact_radius, n: int) -> list:
     return [require_nonnegative("contact_radius", float(r)) for r in np.resize(radii, n)]
 
 
-def _check_basis(basis):
+def check_fe_basis(
+    basis, field="basis", rule="needs the FE mode vectors and model (use compute_modes)"
+):
+    """InputError naming ``field`` unless ``basis`` carries its FE mode vectors and model."""
     if getattr(basis, "mode_vectors", None) is None or not hasattr(basis, "fe_model"):
-        raise InputError("basis", "needs the FE mode vectors and model (use compute_modes)")
+        raise InputError(field, rule)
 
 
 def _check_count(field, value, least):
@@ -190,7 +210,7 @@ def choose_ritz_k(basis, point, contact_radius, duration, peak_force, max_penetr
     the contact). Measured on the cases of docs/fe-convergence.md ("Many-node tails"): the
     contact error with k pseudo-modes is then below 0.88 x tol, plus the time-step error.
     Returns (k, that relative change). WorkLimitError if 2k would exceed ``k_max``."""
-    _check_basis(basis)
+    check_fe_basis(basis)
     for name, value in (("duration", duration), ("peak_force", peak_force),
                         ("max_penetration", max_penetration), ("tol", tol)):  # fmt: skip
         require_positive(name, value)
@@ -201,7 +221,7 @@ def choose_ritz_k(basis, point, contact_radius, duration, peak_force, max_penetr
     load = model.load_vector(check_points(basis.plate, point)[0], contact_radius)[:, None]
     t = np.linspace(0.0, duration, 4001)
 
-    krylov = KrylovTail(basis, load)  # grown once: k, 2k, 4k ... share its first vectors
+    krylov = krylov_tail(basis, load)  # grown once: k, 2k, 4k ... share its first vectors
 
     def response(k):
         omega, Z = krylov.modes(k)
