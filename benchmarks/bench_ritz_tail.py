@@ -3,16 +3,18 @@ the same run, through the scene path (``simulate_scene_modal``, default 200 step
 
     python benchmarks/bench_ritz_tail.py [--out DIR] [--cases test default sweep]
 
-Cases (each run with tail = "quasi-static" and "ritz", tail_modes auto; default and sweep
-also with tail_modes = 32 and 64, which skip the choice of k):
+Cases (each run with tail = "quasi-static" (the baseline), the default tail = "auto" (here
+the Ritz tail with tail_modes = 32) and "ritz" with tail_modes = "auto" (k chosen a
+posteriori); default and sweep also with tail_modes = 64):
 - test: the FE test case of tests/test_coupled_fe.py (Argyris 8x8, 20 kHz, sandstone 30 mm at
   1 m/s, no damping, 0.6 ms); truth: the full-FE reference (Newmark, 1e-7 s, ~7 s).
 - default: the same impact on the default Argyris 23x23 mesh (4805 DOFs) at 20 kHz; cost only
   (its FE reference takes ~10 min: docs/fe-convergence.md has the errors).
 - sweep: the base case of benchmarks/bench_sweep.py (examples/single_impact_base.toml: SSSS,
   fmax 5 kHz, auto mesh = Mindlin P4 12x12, coal 30 mm at 2 m/s, 25 ms, sensor at
-  12.8 kHz, 1 % damping); truth: the same scene at fmax 40 kHz with tail = "ritz"
-  (its difference to 40 kHz quasi-static is reported as the truth's own uncertainty).
+  12.8 kHz, 1 % damping); truth: the same scene at fmax 40 kHz with tail = "ritz" and
+  tail_modes = "auto" (its difference to 40 kHz quasi-static is reported as the truth's own
+  uncertainty).
 Reported: the Ritz pre-pass time (choose k per point + build), k, modes, the run time (best of
 3, numba warm), the first impact's contact errors (restitution, peak force, duration,
 max penetration; max of the four) and the in-band sensor error (relative L2, 0-10 kHz for
@@ -31,17 +33,18 @@ from tailbeam.coupled.auto import build_basis, choose_band, simulate_scene_modal
 from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities, in_band, relative_l2
 from tailbeam.materials import SANDSTONE
 from tailbeam.progress import quiet
-from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
+from tailbeam.scene import DEFAULT_TAIL_MODES, ContactSettings, ModalPlateSettings, Scene
 from tailbeam.scene_file import load_scene
 
 ROOT = Path(__file__).parents[1]
-TAILS = ("quasi-static", "ritz")
-FIXED_K = (32, 64)  # also run with plate.tail_modes set (no choose_ritz_k) on default/sweep
+FIXED_K = (32, 64)  # also run with plate.tail_modes set (32 is the default) on default/sweep
 
 
-def _variants():
-    """(tail, extra ModalPlateSettings) of the compared runs: the baseline, auto, fixed k."""
-    return [("quasi-static", {}), ("ritz", {})] + [("ritz", {"tail_modes": k}) for k in FIXED_K]
+def _variants(fixed=FIXED_K):
+    """(tail, extra ModalPlateSettings) of the compared runs: the baseline, the default
+    (tail "auto": the Ritz tail with tail_modes 32), k chosen a posteriori, fixed k."""
+    auto = [("quasi-static", {}), ("auto", {}), ("ritz", {"tail_modes": "auto"})]
+    return auto + [("ritz", {"tail_modes": k}) for k in fixed if k != DEFAULT_TAIL_MODES]
 
 
 def _with_tail(scene, tail, **modal):
@@ -98,8 +101,8 @@ def case_test():
     a_ref = in_band(ref.t, ref.sensor_a[0], 10_000.0)
     win = ref.t <= 3e-3
     rows = []
-    for tail in TAILS:
-        res, run_s, build_s = _run(_with_tail(scene, tail), basis)
+    for tail, extra in _variants(fixed=()):
+        res, run_s, build_s = _run(_with_tail(scene, tail, **extra), basis)
         err = _contact_errors(res, q_ref)
         a = in_band(ref.t, res.plate_sample(ref.t, [case.sensor])["a"][0], 10_000.0)
         err["sensor"] = relative_l2(a[win], a_ref[win])
@@ -132,7 +135,7 @@ def case_sweep():
         gravity=base.gravity,
     )  # fmt: skip (no noisy sensor)
     point = (0.1, 0.15)
-    truth_scene = _with_tail(base, "ritz", fmax_hz=40000.0)
+    truth_scene = _with_tail(base, "ritz", fmax_hz=40000.0, tail_modes="auto")
     basis = build_basis(base, choose_band(base))
     divisions = basis.info.get("divisions")
     truth_scene = _with_tail(truth_scene, "ritz", mesh_divisions=divisions, theory=basis.theory)
@@ -156,7 +159,9 @@ def case_sweep():
 
 def _row(case, tail, res, basis, run_s, build_s, err):
     info = res.info.get("tail", {})
-    if info.get("tail_modes", "auto") != "auto":
+    if tail == "auto":
+        tail = f"auto (default): {info.get('model')}"
+    if info.get("model") == "ritz":
         tail = f"{tail}, tail_modes = {info['tail_modes']}"
     return {"case": case, "tail": tail, "k": info.get("k", "-"),
             "modes": res.basis.n_modes, "prepass_s": build_s, "run_s": run_s,
