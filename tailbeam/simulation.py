@@ -57,6 +57,9 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
             from tailbeam.coupled.ritz_prepass import check_tail_scene
 
             check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
+            if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
+                note("tail: quasi-static (the stream solver: contact points are not known in "
+                     "advance)")  # fmt: skip
             band = stream_band(scene) if scene.plate_model == "modal" else None
             plate = _stream_plate(scene, band) if band and band["two_way"] else None
             result = _stream(scene, how, plate)
