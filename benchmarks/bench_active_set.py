@@ -3,7 +3,7 @@
     python benchmarks/bench_active_set.py --out DIR [--quick]
 
 1. Per contact: an isolated coal ball (30 mm) striking the plate at 2 m/s, c = 0, g = 0, so
-   the Hertz closed form (tailbeam.hertz) is the truth. For rtol in 1e-8, 1e-10, 1e-12:
+   the Hertz closed form (tailbeam.physics.hertz) is the truth. For rtol in 1e-8, 1e-10, 1e-12:
    wall time per contact (best of 5 x 50 contacts) and the worst relative error of peak
    force, duration, max penetration and v_out of
    - ``ActiveSet.advance`` from contact START to END (the contact part; one Python call), and
@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam import CARBON_STEEL, COAL, Ball, ImpactLaw, Plate, ball_plate_law
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.rigid.model import make_pairs
 from tailbeam.rigid.solver import _KernelIntegrator

@@ -31,11 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
 from tailbeam.coupled import simulate_coupled
-from tailbeam.materials import SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.materials import SANDSTONE
 from tailbeam.solvers.active_set import ActiveSet
 
 RADIUS, SPEED, G, ZETA, XY = 0.03, 2.0, 9.81, 0.01, (0.07, -0.05)

@@ -38,8 +38,8 @@ from tailbeam.coupled.auto import (
     force_error_estimate,
     simulate_scene_modal,
 )
-from tailbeam.output import atomic_output_dir
-from tailbeam.scene_file import load_scene
+from tailbeam.io.output import atomic_output_dir
+from tailbeam.io.scene_file import load_scene
 
 SCENE = Path(__file__).resolve().parents[1] / "examples" / "thirty_balls_modal.toml"
 

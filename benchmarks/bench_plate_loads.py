@@ -21,7 +21,7 @@ Rows:
    extra cost is one static deflection per distinct load point and sensor (this basis: the
    Navier double series, ~1 ms per point), reported separately;
 4. the full case through the whole sensor chain (sensor_outputs), wall time and peak memory;
-   its records are drawn in DIR/sensor_s1.png, sensor_s2.png (tailbeam.sensor_figures).
+   its records are drawn in DIR/sensor_s1.png, sensor_s2.png (tailbeam.signals.sensor_figures).
 Rows 1-2 and 4 have the correction off.
 5. per-load-point costs with an FE Mindlin basis to 10 kHz (computed or cached by
    compute_modes, ~3 s): mode shapes and quasi-static correction for 2 000 random point
@@ -38,14 +38,14 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Plate
 from tailbeam.coupled.forced import forced_response
 from tailbeam.coupled.load_response import plate_response, sensor_outputs
 from tailbeam.coupled.loads import PlateLoads
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Plate
 from tailbeam.progress import quiet
 from tailbeam.scene import SensorSpec
-from tailbeam.sensor_figures import sensor_figures
+from tailbeam.signals.sensor_figures import sensor_figures
 
 FMAX = 10000.0
 ZETA = 0.01

@@ -29,10 +29,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate
-from tailbeam.bodies import STANDARD_GRAVITY as G
-from tailbeam.contact_law import impact_force_scalar
-from tailbeam.output import atomic_output_dir
+from tailbeam.io.output import atomic_output_dir
 from tailbeam.physics import impact
+from tailbeam.physics.bodies import STANDARD_GRAVITY as G
+from tailbeam.physics.contact_law import impact_force_scalar
 from tailbeam.rigid import simulate_rigid
 from tailbeam.rigid.reference import simulate_rigid_reference
 
@@ -62,7 +62,7 @@ TIME_BUDGET = 30.0  # s: a method slower than this at some rtol is not run at ti
 def _law(material, damping=None):
     import dataclasses
 
-    from tailbeam.contact_law import ball_plate_law
+    from tailbeam.physics.contact_law import ball_plate_law
 
     if CONTACT is not None:
         contact = CONTACT if damping is None else dataclasses.replace(CONTACT, damping=damping)

@@ -38,8 +38,8 @@ sys.path.insert(0, str(HERE.parent / "tests"))
 from stream_scenes import modal_scene  # noqa: E402
 from test_stream_solver import _particles, _worst_difference  # noqa: E402
 
-from tailbeam.bodies import Plate  # noqa: E402
 from tailbeam.modal import ssss_kirchhoff_basis  # noqa: E402
+from tailbeam.physics.bodies import Plate  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
 from tailbeam.solvers import active_members, stream  # noqa: E402
 from tailbeam.solvers.reference_plate import ReferencePlate  # noqa: E402

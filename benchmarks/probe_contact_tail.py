@@ -55,14 +55,14 @@ from scipy.special import sici
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_coupled_fe import IMPACT, MESHES, REF_DT, SENSOR, R, _basis, _case  # noqa: E402
 
-from tailbeam.bodies import Ball, Plate  # noqa: E402
-from tailbeam.contact_law import ball_plate_law  # noqa: E402
 from tailbeam.coupled.fe_compare import Case, modal_errors  # noqa: E402
 from tailbeam.coupled.fe_reference import FEImpact, impact_quantities  # noqa: E402
 from tailbeam.coupled.propagator import advance, coefficients  # noqa: E402
 from tailbeam.coupled.solver import simulate_coupled  # noqa: E402
-from tailbeam.materials import CARBON_STEEL, SANDSTONE  # noqa: E402
 from tailbeam.modal import ModalBasis  # noqa: E402
+from tailbeam.physics.bodies import Ball, Plate  # noqa: E402
+from tailbeam.physics.contact_law import ball_plate_law  # noqa: E402
+from tailbeam.physics.materials import CARBON_STEEL, SANDSTONE  # noqa: E402
 from tailbeam.plate import assemble_plate, compute_modes, sparse_solve  # noqa: E402
 from tailbeam.plate.ritz_tail import choose_ritz_k, ritz_tail_modes, with_ritz_tail  # noqa: E402
 

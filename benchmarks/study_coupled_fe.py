@@ -34,14 +34,14 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
 from tailbeam.coupled import records
 from tailbeam.coupled.fe_compare import RECORD_S, Case, modal_errors, observed_order
 from tailbeam.coupled.fe_reference import fe_time_step_study
 from tailbeam.coupled.ritz_prepass import ritz_tail_basis
-from tailbeam.hertz import hertz_max_penetration
-from tailbeam.materials import CARBON_STEEL, SANDSTONE
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.hertz import hertz_max_penetration
+from tailbeam.physics.materials import CARBON_STEEL, SANDSTONE
 from tailbeam.plate import assemble_plate, compute_modes
 from tailbeam.plate.resolution import resolve
 from tailbeam.progress import quiet

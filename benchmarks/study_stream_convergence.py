@@ -39,8 +39,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from stream_scenes import first_impact_difference, ten_ball_scene  # noqa: E402
 
-from tailbeam.bodies import Plate  # noqa: E402
 from tailbeam.modal import ssss_kirchhoff_basis  # noqa: E402
+from tailbeam.physics.bodies import Plate  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
 from tailbeam.solvers.stream import solve_stream  # noqa: E402
 from tailbeam.solvers.stream_plate import StreamPlate  # noqa: E402

@@ -3,7 +3,7 @@
     python examples/flexible_plate_study.py [--quick] [--out DIR]
 
 The paper (sections 4.1-4.3) drops two balls (R = 0.03 m, Table 1) on a rigid 0.6 x 0.6 x 0.01 m
-steel plate. Here the same scenes (tailbeam.scenarios: drop gap, c, d, durations) run on the
+steel plate. Here the same scenes (tailbeam.paper.scenarios: drop gap, c, d, durations) run on the
 simply supported plate (SSSS: a panel bolted/pinned along its edges, the classic choice and the
 one with an exact check) with FE modes up to 20 kHz (the sensor band; Mindlin, chosen by
 tailbeam.plate from the band; ~40 s the first time, then cached), two-way coupled, 1 % modal
@@ -24,14 +24,14 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
 from tailbeam.coupled import simulate_coupled
 from tailbeam.coupled.zener import point_impedance, zener_impact
-from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.paper.scenarios import SCENARIOS
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.rigid import simulate_rigid
-from tailbeam.scenarios import SCENARIOS
 from tailbeam.scene import ContactSettings, SensorSpec
 
 FMAX_HZ = 20000.0

@@ -7,16 +7,16 @@ import functools
 import math
 from dataclasses import dataclass, field
 
-from tailbeam.bodies import STANDARD_GRAVITY, Ball, Plate
-from tailbeam.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
 from tailbeam.errors import (
     InputError,
     require_nonnegative,
     require_positive,
     require_vector,
 )
-from tailbeam.materials import Material
-from tailbeam.noise import NoiseSpec
+from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, Plate
+from tailbeam.physics.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
+from tailbeam.physics.materials import Material
+from tailbeam.signals.noise import NoiseSpec
 
 # Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams'
 # default penetration depth. c = 300 N s/m was chosen by running the paper's three scenarios over

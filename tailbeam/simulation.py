@@ -28,7 +28,7 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
     Parameters
     ----------
     scene : tailbeam.scene.Scene
-        What to simulate (e.g. from ``tailbeam.scene_file.load_scene``).
+        What to simulate (e.g. from ``tailbeam.io.scene_file.load_scene``).
     rtol : float, optional
         Relative tolerance of the solver (rigid: its default 1e-10; stream reference 1e-10).
     max_steps : int, optional
@@ -124,7 +124,7 @@ def stream_band(scene) -> dict:
     """The modal band of a stream scene: plate.fmax, else the sensors' bandwidth (at least
     STREAM_MIN_BAND_HZ), and the coupling (plate.coupling: two-way by default)."""
     from tailbeam.scene import ModalPlateSettings
-    from tailbeam.sensor import resolve
+    from tailbeam.signals.sensor import resolve
 
     settings = scene.modal or ModalPlateSettings()
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)

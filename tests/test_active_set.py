@@ -1,6 +1,6 @@
 """The compiled active-set integrator (tailbeam.solvers.active_set) against independent truths:
 the rigid-plate solver (tailbeam.rigid, its own 1-D kernel), Johnson's Hertz closed forms
-(tailbeam.hertz), conservation laws, the closed-form slide on the frictionless incline, and
+(tailbeam.physics.hertz), conservation laws, the closed-form slide on the frictionless incline, and
 the slow scipy stream reference (tailbeam.solvers.stream_reference) on the shared scenes.
 
 Tolerances are the brief's (1e-10 vs the rigid solver, 1e-8 Hertz, 1e-12 momentum, 1e-9
@@ -16,7 +16,7 @@ from active_set_driver import SceneRun
 from numpy.polynomial import chebyshev as cheb
 
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_ball_law, ball_plate_law
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.rigid import simulate_rigid
 from tailbeam.solvers import cheb_events, step_events
@@ -341,7 +341,7 @@ def test_settle_event():
     penetration): below it at the event, above it at every earlier return (1 ms apart, and
     every event) where the ball touched the plate. A two-ball stack with settle energies (each
     ball touches two pairs or no plate) never settles."""
-    from tailbeam.contact_law import elastic_energy
+    from tailbeam.physics.contact_law import elastic_energy
 
     incline = InclinedPlate()
     g = incline.gravity

@@ -11,12 +11,12 @@ energy. The rigid path (no modes) is checked bit for bit by the unchanged tests/
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law, elastic_energy
 from tailbeam.coupled import propagator, simulate_coupled
 from tailbeam.errors import InputError
-from tailbeam.materials import COAL, SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law, elastic_energy
+from tailbeam.physics.materials import COAL, SANDSTONE
 from tailbeam.solvers.active_set import ActiveSet
 
 R = 0.03

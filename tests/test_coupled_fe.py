@@ -14,12 +14,12 @@ no FE damping matrix; Rayleigh damping, which has one, is checked separately). S
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
 from tailbeam.coupled.fe_compare import Case, modal_errors, observed_order
 from tailbeam.coupled.fe_reference import QUANTITIES, fe_time_step_study
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.materials import CARBON_STEEL, SANDSTONE
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.materials import CARBON_STEEL, SANDSTONE
 from tailbeam.plate import assemble_plate, compute_modes
 
 R = 0.03

@@ -9,15 +9,15 @@ from test_cli import tailbeam
 from test_coupled_fe import IMPACT, MESHES, SENSOR, R, _basis, runs  # noqa: F401 (fixture)
 
 import tailbeam as tb
-from tailbeam.bodies import Ball, Plate
 from tailbeam.coupled.auto import simulate_scene_modal
 from tailbeam.coupled.fe_compare import result_errors
 from tailbeam.coupled.ritz_prepass import first_contact_time, first_contacts, ritz_tail_basis
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.materials import SANDSTONE
+from tailbeam.io.scene_file import loads_scene, scene_to_dict
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.materials import SANDSTONE
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
-from tailbeam.scene_file import loads_scene, scene_to_dict
 
 BAND = 20000.0
 

@@ -7,7 +7,6 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Ball, Plate
 from tailbeam.coupled import CoupledResult
 from tailbeam.coupled.forced import forced_response
 from tailbeam.coupled.load_response import (
@@ -18,8 +17,9 @@ from tailbeam.coupled.load_response import (
 )
 from tailbeam.coupled.loads import PlateLoads
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.materials import SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.materials import SANDSTONE
 from tailbeam.plate import compute_modes
 from tailbeam.scene import SensorSpec
 

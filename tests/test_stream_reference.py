@@ -13,7 +13,7 @@ import pytest
 from stream_scenes import static_penetration_on, ten_ball_scene
 
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_ball_law, ball_plate_law
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.rigid.reference import simulate_rigid_reference
 from tailbeam.solvers.records import EventKind

@@ -21,10 +21,10 @@ from stream_scenes import modal_scene
 from test_stream_solver import _particles, _worst_difference
 
 from tailbeam import COAL, SANDSTONE, Ball, ball_plate_law
-from tailbeam.bodies import Plate
-from tailbeam.materials import CARBON_STEEL
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Plate
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.physics.materials import CARBON_STEEL
 from tailbeam.solvers import active_members, stream
 from tailbeam.solvers.reference_plate import ReferencePlate
 from tailbeam.solvers.stream_plate import StreamPlate

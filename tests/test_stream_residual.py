@@ -15,8 +15,8 @@ import pytest
 from scipy.optimize import brentq
 
 from tailbeam import SANDSTONE, Ball, ball_plate_law
-from tailbeam.materials import CARBON_STEEL
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.physics.materials import CARBON_STEEL
 from tailbeam.solvers import active_pairs as ap
 from tailbeam.solvers.stream import solve_stream
 from tailbeam.solvers.stream_plate import StreamPlate
@@ -27,8 +27,8 @@ BALL = Ball("s", SANDSTONE, R, (0.07, -0.05, R + 1e-4), (0.0, 0.0, -2.0))
 
 
 def _ssss(fmax):
-    from tailbeam.bodies import Plate
     from tailbeam.modal import ssss_kirchhoff_basis
+    from tailbeam.physics.bodies import Plate
 
     return ssss_kirchhoff_basis(Plate(), fmax)
 

@@ -172,12 +172,12 @@ def test_modal_plate_under_stream_loads_matches_the_one_way_solver():
     plate loads through tailbeam.coupled.load_response = tailbeam.coupled's one-way solver
     (the rigid solver + dense replay), at a sensor point over 20 ms."""
     from tailbeam import Ball, ball_plate_law
-    from tailbeam.bodies import Plate
     from tailbeam.coupled.load_response import plate_response
     from tailbeam.coupled.loads import PlateLoads
     from tailbeam.coupled.oneway import simulate_one_way
-    from tailbeam.materials import CARBON_STEEL
     from tailbeam.modal import ssss_kirchhoff_basis
+    from tailbeam.physics.bodies import Plate
+    from tailbeam.physics.materials import CARBON_STEEL
 
     basis = ssss_kirchhoff_basis(Plate(), 5000.0)
     balls = [Ball("a", COAL, 0.02, (0.05, 0.02, 0.03), (0.0, 0.0, -2.0)),
@@ -199,8 +199,8 @@ def test_modal_plate_under_stream_loads_matches_the_one_way_solver():
 
 
 def _ssss(fmax=5000.0):
-    from tailbeam.bodies import Plate
     from tailbeam.modal import ssss_kirchhoff_basis
+    from tailbeam.physics.bodies import Plate
 
     return ssss_kirchhoff_basis(Plate(), fmax)
 
@@ -214,7 +214,7 @@ def test_two_way_single_ball_matches_the_coupled_solver(damping):
     per contact)."""
     from tailbeam import Ball, ball_plate_law
     from tailbeam.coupled import simulate_coupled
-    from tailbeam.materials import CARBON_STEEL
+    from tailbeam.physics.materials import CARBON_STEEL
     from tailbeam.solvers.stream_plate import StreamPlate
 
     basis = _ssss()

@@ -17,15 +17,15 @@ import numpy as np
 import pytest
 
 import tailbeam
-from tailbeam.bodies import Plate
 from tailbeam.cli import main
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.hertz import hertz_max_penetration, hertz_peak_force
-from tailbeam.materials import COAL, SANDSTONE
+from tailbeam.io.scene_file import dumps_scene, load_scene, loads_scene, tomllib
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.hertz import hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.physics.materials import COAL, SANDSTONE
 from tailbeam.rigid import simulate_rigid
 from tailbeam.scene import Scene
-from tailbeam.scene_file import dumps_scene, load_scene, loads_scene, tomllib
 from tailbeam.solvers.stream_result import (
     IMPACT_COLUMNS,
     PARTICLE_COLUMNS,

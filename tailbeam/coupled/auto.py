@@ -41,15 +41,15 @@ import math
 
 import numpy as np
 
-from tailbeam.bodies import STANDARD_GRAVITY
-from tailbeam.contact_law import impact_force, impact_force_scalar
 from tailbeam.coupled.ritz_prepass import check_tail_scene, describe_tail, ritz_tail_basis
 from tailbeam.coupled.solver import simulate_coupled
 from tailbeam.errors import InputError
-from tailbeam.hertz import hertz_contact_duration
+from tailbeam.physics.bodies import STANDARD_GRAVITY
+from tailbeam.physics.contact_law import impact_force, impact_force_scalar
+from tailbeam.physics.hertz import hertz_contact_duration
 from tailbeam.progress import note
 from tailbeam.scene import ModalPlateSettings, Scene
-from tailbeam.sensor import resolve
+from tailbeam.signals.sensor import resolve
 
 BAND_ACCURACY = 5e-3  # target peak-force error from the band: half the outputs' 1 %
 BAND_SAFETY = 20.0  # on the force-error estimate (calibrated, see the module docstring)

@@ -10,13 +10,13 @@ import math
 
 import numpy as np
 
-from tailbeam.contact_patch import load_radius
 from tailbeam.coupled import kernel as K
 from tailbeam.coupled import step as S
 from tailbeam.coupled.records import Compliance, close_contact
 from tailbeam.coupled.result import CoupledResult
 from tailbeam.errors import WorkLimitError
-from tailbeam.hertz import hertz_contact_duration
+from tailbeam.physics.contact_patch import load_radius
+from tailbeam.physics.hertz import hertz_contact_duration
 from tailbeam.progress import task
 from tailbeam.solvers.records import EventKind
 
@@ -47,7 +47,8 @@ class CoupledRun:
         self.omega = np.ascontiguousarray(basis.omega, dtype=float)
         self._ball_arrays(balls, laws)
         self.compliance = Compliance(basis, residual_flexibility)
-        # the load model (tailbeam.contact_patch): a point (Kirchhoff) or the Hertz disc (Mindlin)
+        # the load model (tailbeam.physics.contact_patch): a point (Kirchhoff) or the Hertz disc
+        # (Mindlin)
         pairs = zip(balls, laws, strict=True)
         self.rload = [load_radius(basis.theory, b, lw, gravity) for b, lw in pairs]
         self._state(balls)

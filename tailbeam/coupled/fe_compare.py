@@ -7,7 +7,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tailbeam.contact_patch import load_radius
 from tailbeam.coupled.fe_reference import (
     QUANTITIES,
     fe_reference,
@@ -16,6 +15,7 @@ from tailbeam.coupled.fe_reference import (
     relative_l2,
 )
 from tailbeam.coupled.solver import simulate_coupled
+from tailbeam.physics.contact_patch import load_radius
 
 SENSOR_BAND_HZ = 10_000.0  # the compared sensor band, 0-10 kHz
 SENSOR_WINDOW_S = 3e-3  # compared over the first 3 ms

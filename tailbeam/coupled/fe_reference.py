@@ -29,9 +29,9 @@ import numpy as np
 import scipy.sparse.linalg as spla
 from scipy.optimize import brentq
 
-from tailbeam.bodies import STANDARD_GRAVITY, Ball
-from tailbeam.contact_law import ImpactLaw, impact_force_scalar
 from tailbeam.errors import InputError, WorkLimitError, require_positive
+from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball
+from tailbeam.physics.contact_law import ImpactLaw, impact_force_scalar
 from tailbeam.progress import task
 
 DEFAULT_MAX_WORK = 1e11  # steps x 10 x matrix nonzeros; 1e11 is ~1-2 min on one core

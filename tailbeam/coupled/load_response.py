@@ -20,7 +20,6 @@ import time
 
 import numpy as np
 
-from tailbeam.contact_patch import disc_rule
 from tailbeam.coupled.load_kernel import (
     add_particular,
     empty_outputs,
@@ -29,6 +28,7 @@ from tailbeam.coupled.load_kernel import (
     transition,
 )
 from tailbeam.errors import InputError, WorkLimitError
+from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.model import check_points
 from tailbeam.progress import note, task
 
@@ -70,7 +70,7 @@ def plate_response(
         Uniform sample times, s (spacing equal to 1e-9 relative; taken as t0 + j dt).
     load_radius : float
         Radius (m) of the disc a piece without its own radius is spread over (0: a point
-        load, the Kirchhoff model; see tailbeam.contact_patch).
+        load, the Kirchhoff model; see tailbeam.physics.contact_patch).
     quasi_static : bool
         Add the truncated modes' quasi-static response -R F(t) at the points (R: the
         basis' residual cross compliance; velocity and acceleration as central differences
@@ -289,12 +289,12 @@ def _check_memory(n_points, n_samples, loads, n_modes, batch_nodes, max_bytes):
 
 
 def sensor_outputs(basis, zeta, loads, sensors, duration, *, load_radius=0.0, quasi_static=True):
-    """name -> tailbeam.sensor.SensorOutput for every sensor (SensorSpec) under ``loads``:
+    """name -> tailbeam.signals.sensor.SensorOutput for every sensor (SensorSpec) under ``loads``:
     the chain of ``CoupledResult.sensor_outputs`` (true acceleration on the sensor's fine grid,
     mounted resonance, anti-alias FIR, sampling, noise) over [0, duration] s, driven by
     ``plate_response``. Sensors whose fine grids coincide share one plate response.
     ``sensor_signals(outputs)`` gives what ``write_sensors_csv`` takes."""
-    from tailbeam.sensor import measure
+    from tailbeam.signals.sensor import measure
 
     f_top = float(np.max(basis.frequencies_hz))
     positions = np.array([s.position for s in sensors], dtype=float).reshape(-1, 2)

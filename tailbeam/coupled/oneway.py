@@ -13,9 +13,9 @@ piecewise-linear force (the same node representation as the two-way result).
 
 import numpy as np
 
-from tailbeam.bodies import STANDARD_GRAVITY
-from tailbeam.contact_patch import load_radius
 from tailbeam.coupled.result import CoupledResult
+from tailbeam.physics.bodies import STANDARD_GRAVITY
+from tailbeam.physics.contact_patch import load_radius
 from tailbeam.rigid import simulate_rigid
 
 

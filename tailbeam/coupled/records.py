@@ -15,7 +15,7 @@ _COMPLIANCE_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 class Compliance:
     """Residual compliance at contact points, cached per basis (the static solve is slow).
 
-    radius: the load model's disc radius (tailbeam.contact_patch.load_radius, already on its
+    radius: the load model's disc radius (tailbeam.physics.contact_patch.load_radius, already on its
     5 % logarithmic grid; 0 for a point load)."""
 
     def __init__(self, basis: ModalBasis, enabled: bool):

@@ -173,8 +173,8 @@ class CoupledResult(BallsResult):
 
     @cached_property
     def sensor_outputs(self) -> dict:
-        """name -> tailbeam.sensor.SensorOutput for every sensor (computed on first use)."""
-        from tailbeam.sensor import measure
+        """name -> tailbeam.signals.sensor.SensorOutput for every sensor (computed on first use)."""
+        from tailbeam.signals.sensor import measure
 
         return {
             s.name: measure(s, lambda t, p=s.position: self.true_acceleration(p, t), self.duration,

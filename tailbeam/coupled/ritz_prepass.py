@@ -24,9 +24,9 @@ penetration at the speed after its fall), tolerance AUTO_TOL; the block uses the
 import math
 import time
 
-from tailbeam.contact_patch import load_radius
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.physics.contact_patch import load_radius
+from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.plate import ritz_tail
 from tailbeam.plate.ritz_tail import K_START, MAX_RITZ_VECTORS, choose_ritz_k, with_ritz_tail
 from tailbeam.progress import note, task

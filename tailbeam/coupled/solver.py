@@ -7,12 +7,12 @@
 
 import numpy as np
 
-from tailbeam.bodies import STANDARD_GRAVITY, Ball, check_ball_above_plate
-from tailbeam.contact_law import ImpactLaw
 from tailbeam.coupled.driver import CoupledRun
 from tailbeam.coupled.result import CoupledResult
 from tailbeam.errors import InputError, require_positive
 from tailbeam.modal import ModalBasis
+from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, check_ball_above_plate
+from tailbeam.physics.contact_law import ImpactLaw
 
 DEFAULT_DAMPING_RATIO = 0.01  # of every mode; README "Defaults" (welded steel, light joints)
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid solver's value, so both models stop alike

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from tailbeam.bodies import Plate
 from tailbeam.errors import require_positive
-from tailbeam.hertz import hertz_max_penetration, hertz_peak_force
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.hertz import hertz_max_penetration, hertz_peak_force
 
 
 def point_impedance(plate: Plate) -> float:

@@ -5,7 +5,7 @@ advances the scene: pop the earliest contact, integrate it (the solver-specific
 ``integrate_contact``), then predict that pair's next contact in closed form and push it back.
 With a rigid plate the balls are independent, so each pair is only ever the ball-plate pair.
 
-Adding ball-ball contact (tailbeam.contact_law.ball_ball_law) fits this design: a ball-ball
+Adding ball-ball contact (tailbeam.physics.contact_law.ball_ball_law) fits this design: a ball-ball
 pair's next contact is the first root of |x_i(t) - x_j(t)| = R_i + R_j for two ballistic
 flights (a quartic with gravity cancelling: a quadratic in t), pushed into the same heap; a
 popped prediction is discarded when either ball's trajectory changed since it was made (a

@@ -26,11 +26,11 @@ import math
 from dataclasses import dataclass
 from functools import cached_property
 
-from tailbeam.bodies import Ball, Plate, check_ball_above_plate
-from tailbeam.contact_law import ImpactLaw
 from tailbeam.errors import InputError, require_nonnegative, require_positive, require_real
-from tailbeam.hertz import static_penetration
 from tailbeam.physics import impact
+from tailbeam.physics.bodies import Ball, Plate, check_ball_above_plate
+from tailbeam.physics.contact_law import ImpactLaw
+from tailbeam.physics.hertz import static_penetration
 
 DEFAULT_REST_SPEED = 0.01  # m/s, see the module docstring
 DEFAULT_MAX_CONTACTS = 20_000  # per ball

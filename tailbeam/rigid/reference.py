@@ -14,9 +14,9 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from tailbeam.bodies import STANDARD_GRAVITY
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics import impact
+from tailbeam.physics.bodies import STANDARD_GRAVITY
 from tailbeam.rigid import driver
 from tailbeam.rigid.model import (
     DEFAULT_MAX_CONTACTS,

@@ -47,7 +47,7 @@ class Impact:
 class RigidResult(BallsResult):
     """Result of ``simulate_rigid`` (or the reference solver); see the module docstring.
 
-    plate: the ``tailbeam.bodies.Plate`` (for the leave times of ``particles_table``);
+    plate: the ``tailbeam.physics.bodies.Plate`` (for the leave times of ``particles_table``);
     labels: coal / gangue per ball (empty: ``tailbeam.scene.default_label``).
     """
 

@@ -10,8 +10,8 @@ per ball); the first call compiles the kernel (cached on disk by numba afterward
 
 import numpy as np
 
-from tailbeam.bodies import STANDARD_GRAVITY
 from tailbeam.errors import WorkLimitError
+from tailbeam.physics.bodies import STANDARD_GRAVITY
 from tailbeam.rigid import driver, kernel
 from tailbeam.rigid.model import (
     DEFAULT_MAX_CONTACTS,

@@ -16,7 +16,7 @@ y = y_old + x (F0 + (1 - x) (F1 + x (F2 + (1 - x) (F3 + ...))))  (F has 7 rows).
 
 import numpy as np
 
-from tailbeam.contact_law import ImpactLaw, impact_force
+from tailbeam.physics.contact_law import ImpactLaw, impact_force
 
 FLIGHT, CONTACT, REST = 0, 1, 2
 N_DENSE = 7

@@ -1,4 +1,4 @@
 """Solvers layer: time integration and the searches it needs (broad phase, references).
 
-Depends on the physics layer only (``tailbeam.physics``, ``tailbeam.contact_law``, ...).
+Depends on the physics layer only (``tailbeam.physics``, ``tailbeam.physics.contact_law``, ...).
 """

@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-from tailbeam.contact_law import ball_ball_law
-from tailbeam.contact_patch import load_radius
+from tailbeam.physics.contact_law import ball_ball_law
+from tailbeam.physics.contact_patch import load_radius
 from tailbeam.physics.incline import EDGES
 from tailbeam.solvers.active_pairs import L_CRES, first_contact_step, settle_excess
 from tailbeam.solvers.active_set import ActiveSet, law_table
@@ -159,7 +159,7 @@ class ActiveMembers:
 
     def _load_radius(self, i: int) -> float:
         """Radius (m) of the disc ball i's force is spread over in the residual compliance
-        (tailbeam.contact_patch: 0 on a Kirchhoff basis; the Hertz radius on Mindlin)."""
+        (tailbeam.physics.contact_patch: 0 on a Kirchhoff basis; the Hertz radius on Mindlin)."""
         if i not in self._load_radii:
             b = self.balls
             self._load_radii[i] = load_radius(self.plate.basis.theory, b.particles[i].ball(),

@@ -39,8 +39,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tailbeam.contact_law import ball_ball_law, ball_plate_law
 from tailbeam.errors import InputError, WorkLimitError
+from tailbeam.physics.contact_law import ball_ball_law, ball_plate_law
 from tailbeam.rigid.kernel import dop853_tables
 from tailbeam.solvers import active_kernel as ak
 from tailbeam.solvers.active_pairs import (

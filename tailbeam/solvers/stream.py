@@ -31,8 +31,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tailbeam.contact_law import HERTZ_EXPONENT, elastic_energy
 from tailbeam.errors import InputError, WorkLimitError, require_positive
+from tailbeam.physics.contact_law import HERTZ_EXPONENT, elastic_energy
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import note, quiet, task
 from tailbeam.solvers.broadphase import candidate_pairs

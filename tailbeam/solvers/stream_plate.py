@@ -72,7 +72,7 @@ class StreamPlate:
 
     def compliance(self, xy, radii) -> np.ndarray:
         """(p,) residual compliance (m/N) at points xy (p, 2) m for loads spread over discs
-        of ``radii`` (p,) m (``tailbeam.contact_patch.load_radius``; 0: a point load); all 0
+        of ``radii`` (p,) m (``tailbeam.physics.contact_patch.load_radius``; 0: a point load); all 0
         when residual flexibility is off."""
         xy = np.atleast_2d(np.asarray(xy, dtype=float))
         return np.array([self._compliance(float(x), float(y), float(r))

@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 
-from tailbeam.contact_law import elastic_energy
-from tailbeam.hertz import hertz_contact_duration
+from tailbeam.physics.contact_law import elastic_energy
+from tailbeam.physics.hertz import hertz_contact_duration
 from tailbeam.solvers.records import PLATE, ContactRecord, EventKind
 from tailbeam.solvers.stream_state import GONE, PENDING, SLIDE
 

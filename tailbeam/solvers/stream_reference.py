@@ -6,7 +6,7 @@ integrated by scipy's DOP853 (the method of ``solve_ivp(method="DOP853")``, driv
 step through its ``OdeSolver`` class so that every step can be checked for contacts; rtol
 1e-12 by default). Every pair is watched (O(N^2): this is the slow reference):
 
-* ball-ball and ball-plate contacts use the IMPACT law of ``tailbeam.contact_law``
+* ball-ball and ball-plate contacts use the IMPACT law of ``tailbeam.physics.contact_law``
   (``ball_ball_law``: R = R1 R2 / (R1 + R2), E* of both materials; ``ball_plate_law``), the
   pair geometry of ``tailbeam.physics.pair`` and the plate frame of
   ``tailbeam.physics.incline`` (gravity g (sin theta, 0, -cos theta));
@@ -52,7 +52,8 @@ import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
-from tailbeam.contact_law import (
+from tailbeam.errors import InputError, WorkLimitError, require_positive
+from tailbeam.physics.contact_law import (
     HERTZ_EXPONENT,
     ImpactLaw,
     ball_ball_law,
@@ -61,8 +62,7 @@ from tailbeam.contact_law import (
     elastic_energy,
     impact_force_in_region,
 )
-from tailbeam.errors import InputError, WorkLimitError, require_positive
-from tailbeam.hertz import hertz_max_penetration
+from tailbeam.physics.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES, InclinedPlate
 from tailbeam.physics.pair import pair_kinematics, plate_foot
 from tailbeam.solvers.records import PLATE, ContactRecord, EventKind, LeaveEvent

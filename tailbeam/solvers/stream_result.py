@@ -2,7 +2,7 @@
 
 ``StreamResult`` is built by every stream solver (the slow reference today, the fast solver
 when it lands) from the shared records of ``tailbeam.solvers.records``. Its two tables are
-the outputs ``impacts.csv`` and ``particles.csv`` (tailbeam.results_io), column for column.
+the outputs ``impacts.csv`` and ``particles.csv`` (tailbeam.io.results_io), column for column.
 
 A ``tailbeam.result.Result``: the columns of ``impacts_table()`` and ``particles_table()``
 are documented there (``IMPACT_TABLE_COLUMNS``, ``PARTICLE_COLUMNS``); this module fills the
@@ -75,7 +75,8 @@ class StreamResult(Result):
 
     @property
     def sensor_outputs(self) -> dict:
-        """name -> ``tailbeam.sensor.SensorOutput`` of the sensors (modal plate; else empty)."""
+        """name -> ``tailbeam.signals.sensor.SensorOutput`` of the sensors (modal plate; else
+        empty)."""
         return self.sensors or {}
 
     @property

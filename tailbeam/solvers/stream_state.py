@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tailbeam.contact_law import ball_plate_law
+from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.solvers.flight import advance, band_time, edge_time, pair_time, plate_time
 
 PENDING, FLY, SLIDE, ACTIVE, GONE = range(5)

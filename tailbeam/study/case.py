@@ -52,7 +52,7 @@ def warm_basis(scene_toml: str) -> str:
     """Compute (or load) the modal basis of the scene into the on-disk cache; returns the
     basis description. Runs once per basis_signature before the sweep's cases."""
     from tailbeam.coupled.auto import build_basis
-    from tailbeam.scene_file import loads_scene
+    from tailbeam.io.scene_file import loads_scene
     from tailbeam.simulation import stream_band
 
     try:
@@ -101,7 +101,7 @@ def run_case(scene_toml: str, *_after) -> dict:
     ``_after`` are ignored (Dask dependencies, e.g. the warmed basis; callers before the
     labels moved into the scene passed the coal materials here)."""
     from tailbeam.commands.simulate import solve
-    from tailbeam.scene_file import loads_scene
+    from tailbeam.io.scene_file import loads_scene
 
     t0 = time.perf_counter()
     c0 = time.process_time()

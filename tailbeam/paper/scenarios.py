@@ -4,15 +4,15 @@ Every scenario uses Table 1 materials, radius R = 0.03 m and the rigid 0.6 x 0.6
 carbon-steel plate. The balls sit at x = -0.15 m and x = +0.15 m (0.3 m apart, so they never
 touch), start with their lowest point ``DROP_GAP`` above the plate and move straight down at the
 paper's speed. Where the paper is silent (drop gap, duration, c, d) the values come from the
-calibration against every qualitative claim (tailbeam.claims, benchmarks/claim_map.py;
+calibration against every qualitative claim (tailbeam.paper.claims, benchmarks/claim_map.py;
 docs/reproduction.md, "Defaults").
 """
 
 import math
 from dataclasses import dataclass
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.materials import COAL, SANDSTONE, Material
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.materials import COAL, SANDSTONE, Material
 from tailbeam.scene import ContactSettings, Scene
 
 BALL_RADIUS = 0.03  # m, Table 1

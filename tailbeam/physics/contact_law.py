@@ -19,8 +19,8 @@ import numpy as np
 from numba import vectorize
 
 from tailbeam.errors import InputError, require_nonnegative, require_positive
-from tailbeam.materials import Material, effective_modulus
 from tailbeam.physics import impact
+from tailbeam.physics.materials import Material, effective_modulus
 
 HERTZ_EXPONENT = 1.5
 

@@ -11,7 +11,7 @@ The chain, per ``tailbeam.scene.SensorSpec``:
    the bandwidth is attenuated >= 90 dB (the delta-sigma DAQ design, "alias-free bandwidth");
    its group delay is compensated, as DAQ software does;
 4. sampling at ``sample_rate`` (decimation of the fine grid);
-5. measurement noise, if the spec has any (``tailbeam.noise``), added to the samples.
+5. measurement noise, if the spec has any (``tailbeam.signals.noise``), added to the samples.
 
 Defaults (docs/coupled-and-sensors.md, "Sensor chain"): sample rate 51.2 kHz; bandwidth
 fs/2.56 = 20 kHz, the classic
@@ -29,8 +29,8 @@ from scipy import fft as sp_fft
 from scipy import signal
 
 from tailbeam.errors import InputError
-from tailbeam.noise import noise
 from tailbeam.scene import SensorSpec
+from tailbeam.signals.noise import noise
 
 BANDWIDTH_FRACTION = 1.0 / 2.56  # of the sample rate
 RESONANCE_FACTOR = 3.0  # mounted resonance / bandwidth

@@ -43,7 +43,7 @@ def write_csv(path, header, rows) -> Path:
 def write_impacts_csv(path, impacts) -> Path:
     """The twelve historical columns (IMPACT_COLUMNS) of single-ball ``Impact`` records, one
     row per contact (units in the manifest); the outputs write ``write_result_tables``."""
-    from tailbeam.output import describe
+    from tailbeam.io.output import describe
 
     write_csv(path, IMPACT_COLUMNS, ([getattr(i, c) for c in IMPACT_COLUMNS] for i in impacts))
     return describe(path, units=IMPACT_UNITS)
@@ -51,7 +51,7 @@ def write_impacts_csv(path, impacts) -> Path:
 
 def write_table_csv(path, table: dict, units: dict) -> Path:
     """A table of columns (name -> numpy array, in order) as CSV; units to the manifest."""
-    from tailbeam.output import describe
+    from tailbeam.io.output import describe
 
     header = list(table)
     write_csv(path, header, zip(*(table[c] for c in header), strict=True))
@@ -140,7 +140,7 @@ def timeseries(result, sample_rate: float):
 
 def write_timeseries_csv(path, result, sample_rate: float) -> Path:
     """timeseries.csv on the uniform grid; its units and sample rate go to the manifest."""
-    from tailbeam.output import describe
+    from tailbeam.io.output import describe
 
     header, cols = timeseries(result, sample_rate)
     write_csv(path, header, zip(*(np.asarray(c, dtype=float) for c in cols), strict=True))

@@ -1,11 +1,10 @@
 """Claims of section 4.1 (effect of velocity: coal A at 1 m/s, coal B at 2 m/s) and conclusion 1.
 
-See tailbeam.claims for the conventions (collision numbers, rebound height and speed)."""
+See tailbeam.paper.claims for the conventions (collision numbers, rebound height and speed)."""
 
 import math
 
-from tailbeam.bodies import STANDARD_GRAVITY
-from tailbeam.claims_base import (
+from tailbeam.paper.claims_base import (
     SAME_RESTITUTION_TOL,
     SHORT_CONTACT_RATIO,
     Claim,
@@ -20,6 +19,7 @@ from tailbeam.claims_base import (
     restitutions,
     strictly_decreasing,
 )
+from tailbeam.physics.bodies import STANDARD_GRAVITY
 
 # -- 4.1 effect of velocity (balls "A" 1 m/s and "B" 2 m/s) --------------------------------------
 

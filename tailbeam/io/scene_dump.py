@@ -1,4 +1,4 @@
-"""Writing a Scene back as scene-file TOML (the inverse of ``tailbeam.scene_file``).
+"""Writing a Scene back as scene-file TOML (the inverse of ``tailbeam.io.scene_file``).
 
 ``scene_to_dict`` gives the table with the scene-file keys (echoed into impacts.json and the
 sweep's provenance); ``dumps_scene`` its TOML text, with ``loads_scene(dumps_scene(s)) == s``.
@@ -6,7 +6,7 @@ sweep's provenance); ``dumps_scene`` its TOML text, with ``loads_scene(dumps_sce
 
 import math
 
-from tailbeam.materials import BUILTIN_MATERIALS
+from tailbeam.physics.materials import BUILTIN_MATERIALS
 from tailbeam.scene import Scene, default_label
 
 MATERIAL_KEYS = ("density", "youngs_modulus", "poisson_ratio")

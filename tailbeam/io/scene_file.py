@@ -11,7 +11,6 @@ import re
 import sys
 from pathlib import Path
 
-from tailbeam.bodies import Ball, Plate, check_ball_above_plate
 from tailbeam.errors import (
     InputError,
     require_nonnegative,
@@ -19,9 +18,12 @@ from tailbeam.errors import (
     require_real,
     require_vector,
 )
-from tailbeam.materials import Material, get_material
-from tailbeam.noise import NoiseSpec
+
+# writing back lives in tailbeam.io.scene_dump; re-exported so existing imports keep working
+from tailbeam.io.scene_dump import MATERIAL_KEYS, dumps_scene, scene_to_dict  # noqa: F401
+from tailbeam.physics.bodies import Ball, Plate, check_ball_above_plate
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.physics.materials import Material, get_material
 from tailbeam.preflight import check_scene
 from tailbeam.scene import (
     LABELS,
@@ -31,9 +33,7 @@ from tailbeam.scene import (
     SensorSpec,
     default_label,
 )
-
-# writing back lives in tailbeam.scene_dump; re-exported so existing imports keep working
-from tailbeam.scene_dump import MATERIAL_KEYS, dumps_scene, scene_to_dict  # noqa: F401
+from tailbeam.signals.noise import NoiseSpec
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -293,7 +293,9 @@ def _parse_streams(value, incline: InclinedPlate, materials: dict) -> tuple:
 
 
 def _parse_sensors(value, plate: Plate) -> tuple:
-    from tailbeam.sensor import resolve  # scipy.signal: imported only for scenes with sensors
+    from tailbeam.signals.sensor import (
+        resolve,  # scipy.signal: imported only for scenes with sensors
+    )
 
     sensors = []
     for i, t in enumerate(_array_of_tables("sensors", value), start=1):
@@ -331,7 +333,7 @@ def _parse_sensors(value, plate: Plate) -> tuple:
 
 
 def _parse_noise(field: str, value) -> NoiseSpec:
-    """``noise = RMS`` (white, m/s^2) or a table with NOISE_KEYS (tailbeam.noise)."""
+    """``noise = RMS`` (white, m/s^2) or a table with NOISE_KEYS (tailbeam.signals.noise)."""
     table = value if isinstance(value, dict) else {"rms": value}
     _check_keys(field, table, NOISE_KEYS)
     kwargs = {k: table[k] for k in ("rms", "background", "seed") if k in table}

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from tailbeam.hertz import hertz_max_penetration
+from tailbeam.physics.hertz import hertz_max_penetration
 
 DISC_RINGS, DISC_SPOKES = 4, 12  # 48-point polar rule for a load spread over a disc
 RADIUS_GRID = 0.05  # load radii are rounded to a 5 % logarithmic grid (caching)

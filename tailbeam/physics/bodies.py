@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tailbeam.errors import InputError, require_positive, require_vector
-from tailbeam.materials import CARBON_STEEL, Material
+from tailbeam.physics.materials import CARBON_STEEL, Material
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
 

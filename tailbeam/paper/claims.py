@@ -9,8 +9,8 @@ the same n for every n both balls reach. Rebound height = the apex of the ball's
 above the plate after collision n (Impact.next_apex_height); rebound speed = Impact.v_out.
 """
 
-from tailbeam.claims_base import Claim
-from tailbeam.claims_material import (
+from tailbeam.paper.claims_base import Claim
+from tailbeam.paper.claims_material import (
     claim_42_coal_collides_more,
     claim_42_coal_lower,
     claim_42_coal_peak_sooner,
@@ -23,7 +23,7 @@ from tailbeam.claims_material import (
     claim_43_crossover,
     claim_c3_coal_loses_more,
 )
-from tailbeam.claims_velocity import (
+from tailbeam.paper.claims_velocity import (
     claim_41_a_collides_more,
     claim_41_apex_decreasing,
     claim_41_b_higher_faster_stronger,

@@ -1,9 +1,9 @@
 """Claims of sections 4.2 (coal vs sandstone at 1 m/s) and 4.3 (equal kinetic energy), and
-conclusion 3. See tailbeam.claims for the conventions."""
+conclusion 3. See tailbeam.paper.claims for the conventions."""
 
 import math
 
-from tailbeam.claims_base import (
+from tailbeam.paper.claims_base import (
     MUCH_LARGER_FACTOR,
     Claim,
     all_greater,

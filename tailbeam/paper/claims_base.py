@@ -1,7 +1,7 @@
 """The vocabulary of the paper's claims: the Claim record, thresholds and bounce sequences.
 
-The claims themselves are in tailbeam.claims (registry) with their checks in
-tailbeam.claims_velocity (4.1) and tailbeam.claims_material (4.2, 4.3).
+The claims themselves are in tailbeam.paper.claims (registry) with their checks in
+tailbeam.paper.claims_velocity (4.1) and tailbeam.paper.claims_material (4.2, 4.3).
 
 Rebound height = apex of the ball's lowest point above the plate after a collision
 (Impact.next_apex_height); rebound speed = Impact.v_out; only collisions followed by a flight
@@ -11,7 +11,7 @@ have either.
 import math
 from dataclasses import dataclass
 
-from tailbeam.bodies import STANDARD_GRAVITY
+from tailbeam.physics.bodies import STANDARD_GRAVITY
 
 # "Very short" contact: at most a tenth of the flight that follows (an order of magnitude).
 SHORT_CONTACT_RATIO = 0.1

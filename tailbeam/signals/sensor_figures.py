@@ -1,7 +1,7 @@
 """Figures of an accelerometer's record: time history, amplitude spectrum, Welch PSD and
 spectrogram, with the sensor's position, the frequency resolutions and peak/RMS written on them.
 
-Drawing only (matplotlib's object-oriented API, Agg); the chain itself is tailbeam.sensor.
+Drawing only (matplotlib's object-oriented API, Agg); the chain itself is tailbeam.signals.sensor.
 The Welch PSD and the spectrogram (scipy.signal) make records with several impacts readable:
 the whole-record amplitude spectrum of a multi-impact record is a comb of interference
 fringes, while averaged segments (Welch) show the band levels and the spectrogram shows when
@@ -49,7 +49,7 @@ def _segment(n: int, parts: int, largest: int) -> int:
 
 
 def sensor_stats(output) -> SensorStats:
-    """Peak, RMS and resolutions of a tailbeam.sensor.SensorOutput's sampled record."""
+    """Peak, RMS and resolutions of a tailbeam.signals.sensor.SensorOutput's sampled record."""
     a = np.asarray(output.acceleration, dtype=float)
     n = a.size
     k = int(np.argmax(np.abs(a)))
@@ -165,7 +165,7 @@ def build_sensor_figure(output, position=None) -> Figure:
 
     Parameters
     ----------
-    output : tailbeam.sensor.SensorOutput
+    output : tailbeam.signals.sensor.SensorOutput
         The sampled record (m/s^2) and the chain that produced it.
     position : (x, y) in m, optional
         The sensor's position on the plate, written in the title.
