@@ -1,4 +1,5 @@
-"""The active-set integrator's speed against error, beside tailbeam.rigid's kernel (same run).
+"""The active-set integrator's speed against error, beside tailbeam.solvers.rigid's kernel (same
+run).
 
     python benchmarks/bench_active_set.py --out DIR [--quick]
 
@@ -7,7 +8,7 @@
    wall time per contact (best of 5 x 50 contacts) and the worst relative error of peak
    force, duration, max penetration and v_out of
    - ``ActiveSet.advance`` from contact START to END (the contact part; one Python call), and
-   - tailbeam.rigid's contact integrator (``rigid.solver._KernelIntegrator``: its compiled
+   - tailbeam.solvers.rigid's contact integrator (``rigid.solver._KernelIntegrator``: its compiled
      1-D DOP853 kernel on the penetration ODE plus its thin Python wrapper), the baseline.
    Steps and right-hand-side evaluations per contact are reported too. The active set
    integrates the 3-D state of the ball (6 components) and watches 1 pair + 4 edges, the
@@ -33,9 +34,9 @@ import numpy as np
 from tailbeam import CARBON_STEEL, COAL, Ball, ImpactLaw, Plate, ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.rigid.model import make_pairs
-from tailbeam.rigid.solver import _KernelIntegrator
-from tailbeam.solvers.active_set import ActiveSet
+from tailbeam.solvers.rigid.model import make_pairs
+from tailbeam.solvers.rigid.solver import _KernelIntegrator
+from tailbeam.solvers.stream.active_set import ActiveSet
 
 RADIUS, SPEED = 0.03, 2.0
 

@@ -29,7 +29,6 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from tailbeam.coupled import simulate_coupled
 from tailbeam.io.output import atomic_output_dir
 from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import STANDARD_GRAVITY as G
@@ -38,6 +37,7 @@ from tailbeam.physics.contact_law import impact_force_array
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.scene import ContactSettings, SensorSpec
 from tailbeam.signals.sensor import anti_alias_fir, measure, resolve
+from tailbeam.solvers.coupled import simulate_coupled
 
 R = 0.03
 SENSOR = SensorSpec("S1", (0.0, 0.15))

@@ -26,13 +26,18 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.coupled.auto import build_basis, choose_band, simulate_scene_modal
-from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities, in_band, relative_l2
 from tailbeam.io.scene_file import load_scene
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.materials import SANDSTONE
 from tailbeam.progress import quiet
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
+from tailbeam.solvers.coupled.auto import build_basis, choose_band, simulate_scene_modal
+from tailbeam.solvers.coupled.fe_reference import (
+    QUANTITIES,
+    impact_quantities,
+    in_band,
+    relative_l2,
+)
 
 ROOT = Path(__file__).parents[1]
 TAILS = ("quasi-static", "ritz")

@@ -60,14 +60,14 @@ def run_solvers(out_path, quick):
 
     import tailbeam
     from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_plate_law
-    from tailbeam.coupled import simulate_coupled
     from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.incline import InclinedPlate
-    from tailbeam.rigid import simulate_rigid
-    from tailbeam.rigid.reference import simulate_rigid_reference
-    from tailbeam.solvers.stream import solve_stream
-    from tailbeam.solvers.stream_plate import StreamPlate
-    from tailbeam.solvers.stream_reference import simulate_stream_reference
+    from tailbeam.solvers.coupled import simulate_coupled
+    from tailbeam.solvers.rigid import simulate_rigid
+    from tailbeam.solvers.rigid.reference import simulate_rigid_reference
+    from tailbeam.solvers.stream.stream import solve_stream
+    from tailbeam.solvers.stream.stream_plate import StreamPlate
+    from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
     from tailbeam.streams.generator import Particle
 
     print(f"running {tailbeam.__file__}", flush=True)
@@ -87,8 +87,8 @@ def run_solvers(out_path, quick):
     coupled = simulate_coupled([ball], basis, [slaw], 2e-3, gravity=9.80665)
     runs["coupled"] = (coupled.impacts, coupled.events, coupled.nodes)
     if not quick:
-        from tailbeam.coupled.fe_reference import fe_reference
         from tailbeam.plate import assemble_plate
+        from tailbeam.solvers.coupled.fe_reference import fe_reference
 
         model = assemble_plate(Plate(), "SSSS", theory="kirchhoff", divisions=8)
         fe = fe_reference(model, ball, slaw, 4e-4, dt=2e-7, sensors=[(0.05, 0.10)])

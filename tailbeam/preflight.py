@@ -113,7 +113,7 @@ def check_streams(scene) -> None:
     WorkLimitError names the setting to change."""
     if not scene.needs_stream_solver:
         return
-    from tailbeam.solvers.engine import stream_engine
+    from tailbeam.solvers.stream.engine import stream_engine
 
     engine = stream_engine()
     _check_particle_count(scene, engine, sum(scene.expected_particles()), "expects")

@@ -5,12 +5,12 @@ progress) is keyword-only. It returns one result type, ``tailbeam.result.Result`
 solver the scene chooses:
 
 - rigid plate, no streams, no inclination, no two balls that can touch (their horizontal
-  paths never come within the sum of the radii): ``tailbeam.rigid.simulate_rigid``, exact
+  paths never come within the sum of the radii): ``tailbeam.solvers.rigid.simulate_rigid``, exact
   per ball (its ``Result`` is a ``RigidResult``);
 - modal plate with balls only: the coupled modal solver
-  (``tailbeam.coupled.simulate_scene_modal``, a ``CoupledResult``);
+  (``tailbeam.solvers.coupled.simulate_scene_modal``, a ``CoupledResult``);
 - otherwise (streams, an inclined plate, balls that may touch): the stream solver of
-  ``tailbeam.solvers.engine`` (a ``StreamResult``), on the rigid or the modal plate.
+  ``tailbeam.solvers.stream.engine`` (a ``StreamResult``), on the rigid or the modal plate.
 """
 
 import contextlib
@@ -54,7 +54,7 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
     how = {k: v for k, v in (("rtol", rtol), ("max_steps", max_steps)) if v is not None}
     with contextlib.nullcontext() if progress else quiet():
         if scene.needs_stream_solver:
-            from tailbeam.coupled.ritz_prepass import check_tail_scene
+            from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene
 
             check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
             band = stream_band(scene) if scene.plate_model == "modal" else None
@@ -69,7 +69,7 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
 
 
 def _rigid(scene, how):
-    from tailbeam.rigid import simulate_rigid
+    from tailbeam.solvers.rigid import simulate_rigid
 
     with task(f"simulating {scene.duration:g} s, {len(scene.balls)} balls, rigid plate"):
         return simulate_rigid(
@@ -78,7 +78,7 @@ def _rigid(scene, how):
 
 
 def _modal(scene, how):
-    from tailbeam.coupled import simulate_scene_modal
+    from tailbeam.solvers.coupled import simulate_scene_modal
 
     if how:
         raise InputError(next(iter(how)), "is not a setting of the modal plate solver")
@@ -89,7 +89,7 @@ def _modal(scene, how):
 
 def _stream(scene, how, plate=None):
     from tailbeam.preflight import check_streams
-    from tailbeam.solvers.engine import stream_engine
+    from tailbeam.solvers.stream.engine import stream_engine
 
     check_streams(scene)  # (already done by load_scene; a Scene built in Python needs it)
     engine = stream_engine()
@@ -144,9 +144,9 @@ def stream_band(scene) -> dict:
 
 
 def _basis_and_damping(scene, band):
-    from tailbeam.coupled.auto import build_basis
-    from tailbeam.coupled.solver import modal_damping
     from tailbeam.scene import ModalPlateSettings
+    from tailbeam.solvers.coupled.auto import build_basis
+    from tailbeam.solvers.coupled.solver import modal_damping
 
     settings = scene.modal or ModalPlateSettings()
     basis = build_basis(scene, band)
@@ -154,9 +154,9 @@ def _basis_and_damping(scene, band):
 
 
 def _stream_plate(scene, band):
-    """The two-way modal plate of a stream scene (tailbeam.solvers.stream_plate)."""
+    """The two-way modal plate of a stream scene (tailbeam.solvers.stream.stream_plate)."""
     from tailbeam.scene import ModalPlateSettings
-    from tailbeam.solvers.stream_plate import StreamPlate
+    from tailbeam.solvers.stream.stream_plate import StreamPlate
 
     basis, zeta = _basis_and_damping(scene, band)
     settings = scene.modal or ModalPlateSettings()
@@ -166,11 +166,11 @@ def _stream_plate(scene, band):
 def _modal_sensors(scene, result, band, plate):
     """The sensors of a stream on the modal plate: the stream's plate forces (two-way, or
     one-way from the rigid plate: ``result.loads``) drive the modes exactly; the sensors read
-    the plate there (tailbeam.coupled.load_response)."""
-    from tailbeam.coupled.auto import _choices
-    from tailbeam.coupled.load_response import sensor_outputs
-    from tailbeam.coupled.loads import PlateLoads
+    the plate there (tailbeam.solvers.coupled.load_response)."""
     from tailbeam.scene import ModalPlateSettings
+    from tailbeam.solvers.coupled.auto import _choices
+    from tailbeam.solvers.coupled.load_response import sensor_outputs
+    from tailbeam.solvers.coupled.loads import PlateLoads
 
     settings = scene.modal or ModalPlateSettings()
     if plate is None:

@@ -1,11 +1,11 @@
-"""The automatic modal band (tailbeam.coupled.auto): its estimates against independent truths
-(the SSSS closed-form static compliance and exact SSSS modes), its choice, and its refusals."""
+"""The automatic modal band (tailbeam.solvers.coupled.auto): its estimates against independent
+truths (the SSSS closed-form static compliance and exact SSSS modes), its choice, and its
+refusals."""
 
 import numpy as np
 import pytest
 
 from tailbeam.cli import main
-from tailbeam.coupled import auto, simulate_coupled
 from tailbeam.errors import InputError
 from tailbeam.io.scene_file import loads_scene
 from tailbeam.modal import ssss_kirchhoff_basis
@@ -14,6 +14,7 @@ from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.plate.closed_forms import ssss_static_compliance
+from tailbeam.solvers.coupled import auto, simulate_coupled
 
 PLATE = Plate()
 SCENE = """

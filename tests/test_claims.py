@@ -11,8 +11,8 @@ import pytest
 from tailbeam.paper import claims
 from tailbeam.paper.scenarios import ENERGY, SCENARIOS, equal_energy_speed, run_all, run_scenario
 from tailbeam.physics.materials import COAL, SANDSTONE
-from tailbeam.rigid.reference import simulate_rigid_reference
 from tailbeam.scene import ContactSettings
+from tailbeam.solvers.rigid.reference import simulate_rigid_reference
 
 
 @pytest.fixture(scope="module")

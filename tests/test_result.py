@@ -23,7 +23,7 @@ from tailbeam.physics.bodies import Ball
 from tailbeam.physics.materials import COAL, SANDSTONE
 from tailbeam.result import IMPACT_COLUMNS, IMPACT_TABLE_COLUMNS, PARTICLE_COLUMNS, Result
 from tailbeam.scene import ModalPlateSettings, Scene
-from tailbeam.solvers.engine import stream_engine
+from tailbeam.solvers.stream.engine import stream_engine
 
 G = 9.80665
 GAPS = {"c": 0.02, "s": 0.03, "m": 0.01}  # drop gaps h (m): lowest point above the plate

@@ -14,7 +14,7 @@ from scipy.integrate import simpson
 
 from tailbeam import CARBON_STEEL, COAL, Ball, ImpactLaw, Plate, ball_plate_law
 from tailbeam.physics.bodies import STANDARD_GRAVITY as G
-from tailbeam.rigid import simulate_rigid
+from tailbeam.solvers.rigid import simulate_rigid
 
 R = 0.03
 PLATE = Plate()

@@ -9,7 +9,7 @@ import pytest
 
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, ImpactLaw, Plate, ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
-from tailbeam.rigid import simulate_rigid
+from tailbeam.solvers.rigid import simulate_rigid
 
 GAP = 1e-3  # m between the ball and the plate at t = 0
 

@@ -87,11 +87,11 @@ def test_sensor_on_a_coupled_run_reads_the_plate_acceleration_in_band():
     # they agree to that gain (the chain neither delays nor distorts the band).
     from scipy import signal as sp_signal
 
-    from tailbeam.coupled import simulate_coupled
     from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.bodies import Ball, Plate
     from tailbeam.physics.contact_law import ball_plate_law
     from tailbeam.physics.materials import CARBON_STEEL, COAL
+    from tailbeam.solvers.coupled import simulate_coupled
 
     basis = ssss_kirchhoff_basis(Plate(), 10000.0)
     ball = Ball("c", COAL, 0.03, (0.1, 0.05, 0.031), (0.0, 0.0, -1.0))

@@ -85,7 +85,7 @@ def run(args) -> int:
     check_output_dir(args.out)
     scene = load_scene(args.scene)
     if scene.needs_stream_solver:
-        announce_first_compile("solvers")
+        announce_first_compile("stream")
     else:
         announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
     result = solve(scene)

@@ -31,8 +31,8 @@ DROP_GAP = 0.005
 # to rest overturn the "collides more often" and "short contact" claims
 # (docs/reproduction.md, "Defaults").
 # 4.3: 10 s, because the claim "coal comes to rest first" needs coal declared at rest
-# (tailbeam.rigid's definition: a rebound slower than its rest_speed, 0.01 m/s); with the STEP
-# ramp the damping vanishes at small penetration, so the last bounces are nearly elastic and
+# (tailbeam.solvers.rigid's definition: a rebound slower than its rest_speed, 0.01 m/s); with the
+# STEP ramp the damping vanishes at small penetration, so the last bounces are nearly elastic and
 # coal only comes to rest after ~7 s.
 DURATIONS = {"velocity": 1.0, "material": 1.0, "energy": 10.0}
 
@@ -138,11 +138,11 @@ def run_scenario(
 ):
     """Simulate built-in scenario ``key`` on the rigid plate; returns the solver's RigidResult.
 
-    ``solver``: a function with the signature of ``tailbeam.rigid.simulate_rigid`` (default), e.g.
-    ``tailbeam.rigid.reference.simulate_rigid_reference``.
+    ``solver``: a function with the signature of ``tailbeam.solvers.rigid.simulate_rigid``
+    (default), e.g. ``tailbeam.solvers.rigid.reference.simulate_rigid_reference``.
     """
     if solver is None:
-        from tailbeam.rigid import simulate_rigid as solver  # imported when first needed
+        from tailbeam.solvers.rigid import simulate_rigid as solver  # imported when first needed
 
     scene = SCENARIOS[key].scene(contact, drop_gap=drop_gap, duration=duration)
     return solver(scene.balls, scene.plate, scene.laws(), scene.duration, **solver_options)
