@@ -9,6 +9,8 @@ basis cached before timing), one sensor at 12.8 kHz, 25 ms each. Runs, on the sa
 1. baseline: the cases in a plain loop in this process (run_case, no Dask, no writing);
 2. the sweep on a LocalCluster of 1 worker, then of 2 workers (fresh dataset folder each;
    workers started and warmed before the clock starts).
+``--tail quasi-static`` runs the cases with the quasi-static tail instead of the default
+(``plate.tail = "auto"``: the Ritz tail, 32 pseudo-modes per case).
 Reports cases/s, speed-up over 1 worker, time spent writing the dataset (Zarr + Parquet + CSV)
 as a share of the summed case compute time and of the sweep's wall time, the CPU time of the
 client process (the client, the in-process scheduler and the nannies) per case, and each
@@ -34,7 +36,7 @@ from tailbeam.study.design import expand, parse_sweep
 from tailbeam.study.sweep import close_client, connect, run_sweep
 
 
-def sweep_spec(n_cases: int):
+def sweep_spec(n_cases: int, tail: str | None = None):
     per_class = max(1, n_cases // 2)
 
     def dist(lo, hi, kind="uniform"):
@@ -54,6 +56,8 @@ def sweep_spec(n_cases: int):
         ],
         "sensors": [{"name": "S1", "position": [0.1, 0.15], "sample_rate": 12800.0}],
     }
+    if tail is not None:
+        scene["plate"]["tail"] = tail
     return parse_sweep(
         {
             "scene": scene,
@@ -129,11 +133,16 @@ def dask_run(spec, n_workers: int, out: Path) -> dict:
     }
 
 
-def main(out_dir="out/benchmarks/bench_sweep", quick: bool = False, n_cases: int | None = None):
+def main(
+    out_dir="out/benchmarks/bench_sweep",
+    quick: bool = False,
+    n_cases: int | None = None,
+    tail: str | None = None,
+):
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     n = n_cases or (20 if quick else 200)
-    spec = sweep_spec(n)
+    spec = sweep_spec(n, tail)
     cases = expand(spec)
     _import_writers()
     warm_basis(cases[0].toml)
@@ -207,6 +216,12 @@ if __name__ == "__main__":
     parser.add_argument("--quick", action="store_true", help="20 cases")
     parser.add_argument("--cases", type=int, default=None)
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    parser.add_argument(
+        "--tail",
+        choices=("auto", "quasi-static", "ritz"),
+        default=None,
+        help="plate.tail of the cases (default: the scene default, auto)",
+    )
     args = parser.parse_args()
     np.seterr(all="ignore")
     import dask
@@ -214,4 +229,4 @@ if __name__ == "__main__":
 
     changes = {k: yaml.safe_load(v) for k, v in (item.split("=", 1) for item in args.set)}
     with dask.config.set(changes):
-        main(args.out, quick=args.quick, n_cases=args.cases)
+        main(args.out, quick=args.quick, n_cases=args.cases, tail=args.tail)

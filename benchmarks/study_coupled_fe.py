@@ -16,7 +16,9 @@ and off:
 - "residual + sensor QS": also the truncated modes' quasi-static response at the sensor;
 - "ritz tail + sensor QS": the solver's ``plate.tail = "ritz"`` (tail_modes "auto": Ritz
   pseudo-modes of the truncated modes at the contact point, then the quasi-static residual of
-  the augmented basis), also at the shipped 200 steps/contact.
+  the augmented basis), also at the shipped 200 steps/contact;
+- "default settings": the scene path (simulate_scene_modal) with the default solver settings
+  (plate.tail "auto" = the Ritz tail with tail_modes 32, 200 steps/contact).
 
 Errors: the largest relative error of restitution, peak force, duration and maximum
 penetration ("contact"), and the relative L2 error of the 0-10 kHz sensor acceleration over the
@@ -43,7 +45,14 @@ from tailbeam.plate.resolution import resolve
 from tailbeam.progress import quiet
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
 from tailbeam.solvers.coupled import records
-from tailbeam.solvers.coupled.fe_compare import RECORD_S, Case, modal_errors, observed_order
+from tailbeam.solvers.coupled.auto import simulate_scene_modal
+from tailbeam.solvers.coupled.fe_compare import (
+    RECORD_S,
+    Case,
+    modal_errors,
+    observed_order,
+    result_errors,
+)
 from tailbeam.solvers.coupled.fe_reference import fe_time_step_study
 from tailbeam.solvers.coupled.ritz_prepass import ritz_tail_basis
 
@@ -53,6 +62,7 @@ BANDS = (10000.0, 14000.0, 20000.0, 28000.0, 40000.0)
 TEST_MESHES = {"kirchhoff": 8, "mindlin": 6}
 VARIANTS = ("no residual", "residual (before)", "residual", "residual + sensor QS")
 RITZ = "ritz tail + sensor QS"  # plate.tail = "ritz" (tailbeam.solvers.coupled.ritz_prepass)
+DEFAULTS = "default settings (tail auto: ritz, k = 32; 200 steps/contact)"
 
 
 def _divisions(theory, full):
@@ -88,6 +98,18 @@ def _ritz(basis, ball, theory):
         return ritz_tail_basis(scene, basis, "auto")[0]
 
 
+def _default_settings(case, basis, ref, theory, band, divisions):
+    """Errors of the scene path with the default solver settings (plate.tail "auto", here
+    the Ritz tail with the default tail_modes; 200 steps/contact) on ``basis``."""
+    modal = ModalPlateSettings(theory=theory, damping_ratio=0.0, fmax_hz=band,
+                               mesh_divisions=divisions)  # fmt: skip
+    scene = Scene((case.ball,), Plate(), ContactSettings(damping=0.0), duration=float(ref.t[-1]),
+                  plate_model="modal", modal=modal)  # fmt: skip
+    with quiet():
+        res = simulate_scene_modal(scene, basis=basis)
+    return dict(result_errors(case, res, ref), n_modes=res.basis.n_modes)
+
+
 def study_theory(theory, full, dt, steps, bands=BANDS):
     """Rows of (theory, band, n_modes, variant, contact error, sensor error) for one theory."""
     divisions = _divisions(theory, full)
@@ -118,6 +140,7 @@ def study_theory(theory, full, dt, steps, bands=BANDS):
         ritz_basis = _ritz(basis(), ball, theory)  # plate.tail = "ritz", tail_modes "auto"
         ritz = modal_errors(case, ritz_basis, ref, steps_per_contact=steps)
         ritz200 = modal_errors(case, ritz_basis, ref)
+        defaults = _default_settings(case, basis(), ref, theory, band, divisions)
         n = new["n_modes"]
         rows += [
             (theory, band, n, VARIANTS[0], none["contact"], none["sensor_no_qs"]),
@@ -129,6 +152,8 @@ def study_theory(theory, full, dt, steps, bands=BANDS):
             (theory, band, ritz["n_modes"], RITZ, ritz["contact"], ritz["sensor"]),
             (theory, band, ritz["n_modes"], f"{RITZ}, 200 steps/contact", ritz200["contact"],
              ritz200["sensor"]),
+            (theory, band, defaults["n_modes"], DEFAULTS, defaults["contact"],
+             defaults["sensor"]),
         ]  # fmt: skip
         print(f"  {band:7.0f} Hz {n:4d} modes: contact {none['contact']:.2e} / "
               f"{old['contact']:.2e} / {new['contact']:.2e}; sensor {none['sensor_no_qs']:.2e}"

@@ -48,7 +48,7 @@ from tailbeam.physics.hertz import hertz_contact_duration
 from tailbeam.progress import note
 from tailbeam.scene import ModalPlateSettings, Scene
 from tailbeam.signals.sensor import resolve
-from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene, describe_tail, ritz_tail_basis
+from tailbeam.solvers.coupled.ritz_prepass import apply_tail, check_tail_scene, describe_tail
 from tailbeam.solvers.coupled.solver import simulate_coupled
 
 BAND_ACCURACY = 5e-3  # target peak-force error from the band: half the outputs' 1 %
@@ -248,12 +248,8 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
     band = choose_band(scene, settings)
     if basis is None:
         basis = build_basis(scene, band, use_cache=use_cache)
-    tail = None
-    if settings.tail == "ritz":
-        basis, tail = ritz_tail_basis(scene, basis, settings.tail_modes)
-    choices = _choices(band, basis)
-    if tail is not None:
-        choices["tail"] = tail
+    basis, tail = apply_tail(scene, basis, settings)
+    choices = {**_choices(band, basis), "tail": tail}
     note(describe_choices(choices))  # before the run, so a long run says what it runs
     result = simulate_coupled(
         scene.balls,
@@ -302,7 +298,8 @@ def describe_choices(info: dict) -> str:
         )
     if describe_tail(info.get("tail", {})):
         parts.append(describe_tail(info["tail"]))
-    parts.append(f"est. peak-force truncation error {band['truncation_force_error']:.1e}")
+    without = " without the Ritz tail" if info.get("tail", {}).get("model") == "ritz" else ""
+    parts.append(f"est. peak-force truncation error{without} {band['truncation_force_error']:.1e}")
     if not band["sensor_band_covered"]:
         parts.append("band below a sensor's bandwidth")
     return "; ".join(parts)

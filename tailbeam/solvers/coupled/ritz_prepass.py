@@ -30,6 +30,7 @@ from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration
 from tailbeam.plate import ritz_tail
 from tailbeam.plate.ritz_tail import K_START, MAX_RITZ_VECTORS, choose_ritz_k, with_ritz_tail
 from tailbeam.progress import note, task
+from tailbeam.scene import DEFAULT_TAIL_MODES
 
 AUTO_TOL = 1e-5  # choose_ritz_k's tolerance (relative to the max penetration)
 AUTO_K_MAX = 512  # choose_ritz_k's k_max per point (fewer if the points share MAX_RITZ_VECTORS)
@@ -146,6 +147,7 @@ def ritz_tail_basis(scene, basis, tail_modes="auto"):
     info.update(k=int(k), added_modes=int(added), build_s=time.perf_counter() - started,
                 contact_points=[list(map(float, p)) for p in xy], load_radii_m=radii)  # fmt: skip
     how = "auto, largest over the points" if tail_modes == "auto" else "plate.tail_modes"
+    how += ", the default" if tail_modes == DEFAULT_TAIL_MODES else ""
     note(
         f"Ritz tail: k = {k} ({how}) at {len(points)} first-contact point(s), "
         f"{added} pseudo-modes added to {basis.n_modes} modes"
@@ -153,8 +155,44 @@ def ritz_tail_basis(scene, basis, tail_modes="auto"):
     return augmented, info
 
 
+def apply_tail(scene, basis, settings):
+    """The basis the coupled solver runs on and result.info["tail"], from ``settings.tail``
+    (the scene's ``ModalPlateSettings``):
+    "ritz" builds the Ritz tail (errors name plate.tail / plate.tail_modes), "quasi-static"
+    keeps ``basis``, "auto" builds it where it applies and otherwise keeps ``basis`` with
+    the reason (said on stderr): a basis without an FE model (closed form), residual
+    flexibility off, one-way coupling, or more pseudo-modes than MAX_RITZ_VECTORS."""
+    if settings.tail == "ritz":
+        return ritz_tail_basis(scene, basis, settings.tail_modes)
+    if settings.tail == "quasi-static":
+        return basis, {"model": "quasi-static", "reason": "plate.tail"}
+    why = _why_not_ritz(settings, basis)
+    if why is None:
+        try:
+            return ritz_tail_basis(scene, basis, settings.tail_modes)
+        except WorkLimitError as err:
+            why = str(err)
+    note(f"tail: quasi-static ({why})")
+    return basis, {"model": "quasi-static", "reason": why}
+
+
+def _why_not_ritz(settings, basis) -> str | None:
+    """Why plate.tail = "auto" keeps the quasi-static tail, or None if the Ritz tail applies."""
+    if not settings.residual_flexibility:
+        return "plate.residual_flexibility is off"
+    if settings.coupling != "two-way":
+        return "one-way coupling"
+    try:
+        ritz_tail.check_fe_basis(basis)
+    except InputError:
+        return f"the {basis.theory} {basis.boundary} basis is a closed form, without an FE model"
+    return None
+
+
 def describe_tail(info: dict) -> str:
     """One phrase for describe_choices: the tail model."""
+    if info.get("model") == "quasi-static":
+        return "" if info.get("reason") == "plate.tail" else "quasi-static tail"
     if info.get("model") != "ritz":
         return ""
     return f"Ritz tail k = {info.get('k', 0)}, +{info['added_modes']} modes"
