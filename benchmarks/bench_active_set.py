@@ -1,13 +1,14 @@
-"""The active-set integrator's speed against error, beside tailbeam.rigid's kernel (same run).
+"""The active-set integrator's speed against error, beside tailbeam.solvers.rigid's kernel (same
+run).
 
     python benchmarks/bench_active_set.py --out DIR [--quick]
 
 1. Per contact: an isolated coal ball (30 mm) striking the plate at 2 m/s, c = 0, g = 0, so
-   the Hertz closed form (tailbeam.hertz) is the truth. For rtol in 1e-8, 1e-10, 1e-12:
+   the Hertz closed form (tailbeam.physics.hertz) is the truth. For rtol in 1e-8, 1e-10, 1e-12:
    wall time per contact (best of 5 x 50 contacts) and the worst relative error of peak
    force, duration, max penetration and v_out of
    - ``ActiveSet.advance`` from contact START to END (the contact part; one Python call), and
-   - tailbeam.rigid's contact integrator (``rigid.solver._KernelIntegrator``: its compiled
+   - tailbeam.solvers.rigid's contact integrator (``rigid.solver._KernelIntegrator``: its compiled
      1-D DOP853 kernel on the penetration ODE plus its thin Python wrapper), the baseline.
    Steps and right-hand-side evaluations per contact are reported too. The active set
    integrates the 3-D state of the ball (6 components) and watches 1 pair + 4 edges, the
@@ -31,11 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam import CARBON_STEEL, COAL, Ball, ImpactLaw, Plate, ball_plate_law
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.rigid.model import make_pairs
-from tailbeam.rigid.solver import _KernelIntegrator
-from tailbeam.solvers.active_set import ActiveSet
+from tailbeam.solvers.rigid.model import make_pairs
+from tailbeam.solvers.rigid.solver import _KernelIntegrator
+from tailbeam.solvers.stream.active_set import ActiveSet
 
 RADIUS, SPEED = 0.03, 2.0
 

@@ -31,12 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
-from tailbeam.coupled import simulate_coupled
-from tailbeam.materials import SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
-from tailbeam.solvers.active_set import ActiveSet
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.materials import SANDSTONE
+from tailbeam.solvers.coupled import simulate_coupled
+from tailbeam.solvers.stream.active_set import ActiveSet
 
 RADIUS, SPEED, G, ZETA, XY = 0.03, 2.0, 9.81, 0.01, (0.07, -0.05)
 PLATE = Plate()
@@ -98,7 +98,7 @@ def truth_of(basis):
 
 def rigid_truth(rtol):
     """The rigid plate: the active set itself at rtol 1e-13 (tests/test_active_set.py checks
-    it against tailbeam.rigid to 2e-11)."""
+    it against tailbeam.solvers.rigid to 2e-11)."""
     return active_contact(None, 1e-13, 1)[1] if rtol else None
 
 

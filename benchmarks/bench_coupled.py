@@ -29,15 +29,15 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from tailbeam.bodies import STANDARD_GRAVITY as G
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import impact_force_array
-from tailbeam.coupled import simulate_coupled
-from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
+from tailbeam.io.output import atomic_output_dir
 from tailbeam.modal import ssss_kirchhoff_basis
-from tailbeam.output import atomic_output_dir
+from tailbeam.physics.bodies import STANDARD_GRAVITY as G
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import impact_force_array
+from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.scene import ContactSettings, SensorSpec
-from tailbeam.sensor import anti_alias_fir, measure, resolve
+from tailbeam.signals.sensor import anti_alias_fir, measure, resolve
+from tailbeam.solvers.coupled import simulate_coupled
 
 R = 0.03
 SENSOR = SensorSpec("S1", (0.0, 0.15))
@@ -122,7 +122,8 @@ def run_baseline(basis, balls, laws, duration, method, rtol):
         qdd = -(phi.T @ f) - 2 * ZETA * om[:, None] * qd - om[:, None] ** 2 * q
         return phi_s @ qdd
 
-    # the sensor's fine grid (as tailbeam.sensor.measure builds it), filled while integrating:
+    # the sensor's fine grid (as tailbeam.signals.sensor.measure builds it), filled while
+    # integrating:
     # t_eval, not dense output, in flight (dense output of a 1 s run would need gigabytes)
     chain = resolve(SENSOR, float(basis.frequencies_hz[-1]))
     delay = (len(anti_alias_fir(chain)) - 1) // 2

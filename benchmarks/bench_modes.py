@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Plate
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate import compute_modes
 from tailbeam.plate.closed_forms import bending_wavenumber, ssss_modes
 

@@ -5,7 +5,7 @@
 Scenes (paper section 4; contact parameters: tailbeam.scene.ContactSettings defaults, plus one
 scene at c = 800 N s/m with more bounces): one ball dropped from 0.1 m gap at coal 1 m/s,
 coal 2 m/s, sandstone 1 m/s, simulated for 1 s. Truth: the reference
-(tailbeam.rigid.reference: DOP853 rtol 1e-12 restarted at every kink). Error metric: max
+(tailbeam.solvers.rigid.reference: DOP853 rtol 1e-12 restarted at every kink). Error metric: max
 relative error over every impact's peak force and every apex height. Baselines: solve_ivp
 (LSODA, RK45, DOP853, Radau, BDF) on the full ODE in (z, vz) with the IMPACT force, contact
 start/end as terminal events (restart there), dF/dt = 0 and vz = 0 as events for the peaks and
@@ -29,12 +29,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate
-from tailbeam.bodies import STANDARD_GRAVITY as G
-from tailbeam.contact_law import impact_force_scalar
-from tailbeam.output import atomic_output_dir
+from tailbeam.io.output import atomic_output_dir
 from tailbeam.physics import impact
-from tailbeam.rigid import simulate_rigid
-from tailbeam.rigid.reference import simulate_rigid_reference
+from tailbeam.physics.bodies import STANDARD_GRAVITY as G
+from tailbeam.physics.contact_law import impact_force_scalar
+from tailbeam.solvers.rigid import simulate_rigid
+from tailbeam.solvers.rigid.reference import simulate_rigid_reference
 
 try:  # the scene defaults, if the scenes module exists
     from tailbeam.scene import ContactSettings
@@ -62,7 +62,7 @@ TIME_BUDGET = 30.0  # s: a method slower than this at some rtol is not run at ti
 def _law(material, damping=None):
     import dataclasses
 
-    from tailbeam.contact_law import ball_plate_law
+    from tailbeam.physics.contact_law import ball_plate_law
 
     if CONTACT is not None:
         contact = CONTACT if damping is None else dataclasses.replace(CONTACT, damping=damping)
@@ -166,7 +166,7 @@ def compile_time():
     code = (
         "import time; t0 = time.perf_counter();"
         "from tailbeam import COAL, CARBON_STEEL, Ball, Plate, ball_plate_law;"
-        "from tailbeam.rigid import simulate_rigid;"
+        "from tailbeam.solvers.rigid import simulate_rigid;"
         "law = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0);"
         "b = Ball('A', COAL, 0.03, (0, 0, 0.031), (0, 0, -1.0));"
         "simulate_rigid([b], Plate(), [law], 0.01); print(time.perf_counter() - t0)"

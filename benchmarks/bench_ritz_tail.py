@@ -28,13 +28,18 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.coupled.auto import build_basis, choose_band, simulate_scene_modal
-from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities, in_band, relative_l2
-from tailbeam.materials import SANDSTONE
+from tailbeam.io.scene_file import load_scene
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.materials import SANDSTONE
 from tailbeam.progress import quiet
 from tailbeam.scene import DEFAULT_TAIL_MODES, ContactSettings, ModalPlateSettings, Scene
-from tailbeam.scene_file import load_scene
+from tailbeam.solvers.coupled.auto import build_basis, choose_band, simulate_scene_modal
+from tailbeam.solvers.coupled.fe_reference import (
+    QUANTITIES,
+    impact_quantities,
+    in_band,
+    relative_l2,
+)
 
 ROOT = Path(__file__).parents[1]
 FIXED_K = (32, 64)  # also run with plate.tail_modes set (32 is the default) on default/sweep

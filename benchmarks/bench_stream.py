@@ -62,7 +62,7 @@ def run_case(path: str, rtol: float) -> dict:
     import resource
 
     import tailbeam
-    from tailbeam.scene_file import load_scene
+    from tailbeam.io.scene_file import load_scene
 
     scene = load_scene(path)
     t0 = time.perf_counter()

@@ -20,11 +20,11 @@ sys.path.insert(0, str(Path(__file__).parent))
 import bench_stream  # noqa: E402
 
 from tailbeam import SANDSTONE, Ball  # noqa: E402
+from tailbeam.io.scene_file import load_scene  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
-from tailbeam.scene_file import load_scene  # noqa: E402
 from tailbeam.simulation import _stream_plate, stream_band  # noqa: E402
-from tailbeam.solvers.stream import solve_stream  # noqa: E402
-from tailbeam.solvers.stream_plate import StreamPlate  # noqa: E402
+from tailbeam.solvers.stream.stream import solve_stream  # noqa: E402
+from tailbeam.solvers.stream.stream_plate import StreamPlate  # noqa: E402
 from tailbeam.streams.generator import Particle  # noqa: E402
 
 R = 0.03

@@ -2,7 +2,7 @@
 
 The paper gives no damping c, penetration depth d or drop height. This study runs the three
 scenarios (sections 4.1-4.3) at every point of a grid of (c, d, drop gap) and records which
-claims hold (tailbeam.claims). Outputs in --out DIR:
+claims hold (tailbeam.paper.claims). Outputs in --out DIR:
   claim_map.csv  one row per grid point: c, d, gap, number of claims holding, 0/1 per claim
   table.csv      per claim: fraction of the grid where it holds, and of the defaults'
                  neighbourhood (c within x/÷1.5, d within x/÷2, gap <= 10 mm)
@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam import claims as claims_mod
 from tailbeam.errors import WorkLimitError
-from tailbeam.figures import claim_map_figure
-from tailbeam.scenarios import DROP_GAP, run_all
+from tailbeam.paper import claims as claims_mod
+from tailbeam.paper.figures import claim_map_figure
+from tailbeam.paper.scenarios import DROP_GAP, run_all
 from tailbeam.scene import DEFAULT_DAMPING, DEFAULT_PENETRATION, ContactSettings
 
 # Dense near the band where every claim holds, coarser far from it; the defaults are grid points.

@@ -11,6 +11,7 @@ if any differs. The first run of each tree compiles the kernels (~15 s each).
 """
 
 import argparse
+import importlib
 import pickle
 import subprocess
 import sys
@@ -70,6 +71,18 @@ def extract_revision(base, tmp: Path) -> Path:
     with tarfile.open(tmp / "base.tar") as tar:
         tar.extractall(old, filter="data")
     return old
+
+
+def import_either(path: str, before_layers: str):
+    """Module ``path`` of the tree on sys.path, or ``before_layers``, its path in a revision
+    before the layers move (issue 7: tailbeam.rigid -> tailbeam.solvers.rigid, ...), so that
+    a base on either side of the move runs the same code."""
+    try:
+        return importlib.import_module(path)
+    except ModuleNotFoundError as err:
+        if not path.startswith(err.name or "-"):
+            raise  # a dependency is missing, not the moved module
+        return importlib.import_module(before_layers)
 
 
 def main(base):

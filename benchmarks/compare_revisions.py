@@ -31,7 +31,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from compare_active_set_revisions import extract_revision
+from compare_active_set_revisions import extract_revision, import_either
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -60,15 +60,26 @@ def run_solvers(out_path, quick):
 
     import tailbeam
     from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_plate_law
-    from tailbeam.coupled import simulate_coupled
     from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.incline import InclinedPlate
-    from tailbeam.rigid import simulate_rigid
-    from tailbeam.rigid.reference import simulate_rigid_reference
-    from tailbeam.solvers.stream import solve_stream
-    from tailbeam.solvers.stream_plate import StreamPlate
-    from tailbeam.solvers.stream_reference import simulate_stream_reference
     from tailbeam.streams.generator import Particle
+
+    simulate_coupled = import_either(
+        "tailbeam.solvers.coupled", "tailbeam.coupled"
+    ).simulate_coupled
+    simulate_rigid = import_either("tailbeam.solvers.rigid", "tailbeam.rigid").simulate_rigid
+    simulate_rigid_reference = import_either(
+        "tailbeam.solvers.rigid.reference", "tailbeam.rigid.reference"
+    ).simulate_rigid_reference
+    solve_stream = import_either(
+        "tailbeam.solvers.stream.stream", "tailbeam.solvers.stream"
+    ).solve_stream
+    StreamPlate = import_either(
+        "tailbeam.solvers.stream.stream_plate", "tailbeam.solvers.stream_plate"
+    ).StreamPlate
+    simulate_stream_reference = import_either(
+        "tailbeam.solvers.stream.stream_reference", "tailbeam.solvers.stream_reference"
+    ).simulate_stream_reference
 
     print(f"running {tailbeam.__file__}", flush=True)
     law = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0, penetration=1e-4)
@@ -87,8 +98,11 @@ def run_solvers(out_path, quick):
     coupled = simulate_coupled([ball], basis, [slaw], 2e-3, gravity=9.80665)
     runs["coupled"] = (coupled.impacts, coupled.events, coupled.nodes)
     if not quick:
-        from tailbeam.coupled.fe_reference import fe_reference
         from tailbeam.plate import assemble_plate
+
+        fe_reference = import_either(
+            "tailbeam.solvers.coupled.fe_reference", "tailbeam.coupled.fe_reference"
+        ).fe_reference
 
         model = assemble_plate(Plate(), "SSSS", theory="kirchhoff", divisions=8)
         fe = fe_reference(model, ball, slaw, 4e-4, dt=2e-7, sensors=[(0.05, 0.10)])

@@ -5,7 +5,7 @@
         [--divisions N --ref-cache FILE.npz] [--rayleigh]
 
 The case of tests/test_coupled_fe.py (Argyris 8x8 / Mindlin P4 6x6, SSSS, sandstone 30 mm at
-1 m/s, plate damping 0) against the full-FE reference (tailbeam.coupled.fe_reference, 1e-7 s
+1 m/s, plate damping 0) against the full-FE reference (tailbeam.solvers.coupled.fe_reference, 1e-7 s
 Kirchhoff, 2e-7 s Mindlin). Each part prints a markdown table (seconds to a few minutes):
 
 - steps: SIGNED relative errors of the four contact quantities at 14/20/28 kHz for 200, 400,
@@ -55,16 +55,16 @@ from scipy.special import sici
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_coupled_fe import IMPACT, MESHES, REF_DT, SENSOR, R, _basis, _case  # noqa: E402
 
-from tailbeam.bodies import Ball, Plate  # noqa: E402
-from tailbeam.contact_law import ball_plate_law  # noqa: E402
-from tailbeam.coupled.fe_compare import Case, modal_errors  # noqa: E402
-from tailbeam.coupled.fe_reference import FEImpact, impact_quantities  # noqa: E402
-from tailbeam.coupled.propagator import advance, coefficients  # noqa: E402
-from tailbeam.coupled.solver import simulate_coupled  # noqa: E402
-from tailbeam.materials import CARBON_STEEL, SANDSTONE  # noqa: E402
 from tailbeam.modal import ModalBasis  # noqa: E402
+from tailbeam.physics.bodies import Ball, Plate  # noqa: E402
+from tailbeam.physics.contact_law import ball_plate_law  # noqa: E402
+from tailbeam.physics.materials import CARBON_STEEL, SANDSTONE  # noqa: E402
 from tailbeam.plate import assemble_plate, compute_modes, sparse_solve  # noqa: E402
 from tailbeam.plate.ritz_tail import choose_ritz_k, ritz_tail_modes, with_ritz_tail  # noqa: E402
+from tailbeam.solvers.coupled.fe_compare import Case, modal_errors  # noqa: E402
+from tailbeam.solvers.coupled.fe_reference import FEImpact, impact_quantities  # noqa: E402
+from tailbeam.solvers.coupled.propagator import advance, coefficients  # noqa: E402
+from tailbeam.solvers.coupled.solver import simulate_coupled  # noqa: E402
 
 BANDS_HZ = (14e3, 20e3, 28e3)
 SHORT = {"restitution": "e", "peak_force": "F_max", "duration": "T", "max_penetration": "d_max"}

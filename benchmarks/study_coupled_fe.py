@@ -4,8 +4,8 @@
         [--theory kirchhoff|mindlin|both] [--bands HZ ...] [--dt S]
 
 One impact (sandstone, 30 mm, 1 m/s at (0.05, 0.03) m on the 0.6 m SSSS steel plate), the
-sensor 7 cm away at (0.05, 0.10) m. Truth: tailbeam.coupled.fe_reference on the SAME mesh and
-element (every DOF, Newmark average acceleration at 1e-7 s, the contact law implicit each step;
+sensor 7 cm away at (0.05, 0.10) m. Truth: tailbeam.solvers.coupled.fe_reference on the SAME mesh
+and element (every DOF, Newmark average acceleration at 1e-7 s, the contact law implicit each step;
 its own step study is printed). The modal solver runs at bands 10-40 kHz, 800 steps per contact
 (so the time step stays below the truncation error), plate damping 0, with each correction on
 and off:
@@ -37,32 +37,32 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
-from tailbeam.coupled import records
-from tailbeam.coupled.auto import simulate_scene_modal
-from tailbeam.coupled.fe_compare import (
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.hertz import hertz_max_penetration
+from tailbeam.physics.materials import CARBON_STEEL, SANDSTONE
+from tailbeam.plate import assemble_plate, compute_modes
+from tailbeam.plate.resolution import resolve
+from tailbeam.progress import quiet
+from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
+from tailbeam.solvers.coupled import records
+from tailbeam.solvers.coupled.auto import simulate_scene_modal
+from tailbeam.solvers.coupled.fe_compare import (
     RECORD_S,
     Case,
     modal_errors,
     observed_order,
     result_errors,
 )
-from tailbeam.coupled.fe_reference import fe_time_step_study
-from tailbeam.coupled.ritz_prepass import ritz_tail_basis
-from tailbeam.hertz import hertz_max_penetration
-from tailbeam.materials import CARBON_STEEL, SANDSTONE
-from tailbeam.plate import assemble_plate, compute_modes
-from tailbeam.plate.resolution import resolve
-from tailbeam.progress import quiet
-from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
+from tailbeam.solvers.coupled.fe_reference import fe_time_step_study
+from tailbeam.solvers.coupled.ritz_prepass import ritz_tail_basis
 
 R = 0.03
 IMPACT, SENSOR = (0.05, 0.03), (0.05, 0.10)
 BANDS = (10000.0, 14000.0, 20000.0, 28000.0, 40000.0)
 TEST_MESHES = {"kirchhoff": 8, "mindlin": 6}
 VARIANTS = ("no residual", "residual (before)", "residual", "residual + sensor QS")
-RITZ = "ritz tail + sensor QS"  # plate.tail = "ritz" (tailbeam.coupled.ritz_prepass)
+RITZ = "ritz tail + sensor QS"  # plate.tail = "ritz" (tailbeam.solvers.coupled.ritz_prepass)
 DEFAULTS = "default settings (tail auto: ritz, k = 32; 200 steps/contact)"
 
 

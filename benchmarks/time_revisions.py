@@ -16,7 +16,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from compare_active_set_revisions import extract_revision
+from compare_active_set_revisions import extract_revision, import_either
 
 ROOT = Path(__file__).resolve().parents[1]
 REPEATS = 40
@@ -29,7 +29,8 @@ def time_rigid(label):
     import numpy as np
 
     from tailbeam import CARBON_STEEL, COAL, Ball, Plate, ball_plate_law
-    from tailbeam.rigid import simulate_rigid
+
+    simulate_rigid = import_either("tailbeam.solvers.rigid", "tailbeam.rigid").simulate_rigid
 
     law = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0, penetration=1e-4)
     balls = [Ball(f"b{i}", COAL, 0.03, (-0.2 + 0.04 * i, 0.0, 0.13 + 0.01 * i),

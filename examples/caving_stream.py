@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import tailbeam
-from tailbeam.scene_file import loads_scene
+from tailbeam.io.scene_file import loads_scene
 from tailbeam.study.features import spectral_centroid
 
 HERE = Path(__file__).resolve().parent

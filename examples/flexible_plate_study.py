@@ -3,7 +3,7 @@
     python examples/flexible_plate_study.py [--quick] [--out DIR]
 
 The paper (sections 4.1-4.3) drops two balls (R = 0.03 m, Table 1) on a rigid 0.6 x 0.6 x 0.01 m
-steel plate. Here the same scenes (tailbeam.scenarios: drop gap, c, d, durations) run on the
+steel plate. Here the same scenes (tailbeam.paper.scenarios: drop gap, c, d, durations) run on the
 simply supported plate (SSSS: a panel bolted/pinned along its edges, the classic choice and the
 one with an exact check) with FE modes up to 20 kHz (the sensor band; Mindlin, chosen by
 tailbeam.plate from the band; ~40 s the first time, then cached), two-way coupled, 1 % modal
@@ -11,8 +11,8 @@ damping, and again one-way (rigid-plate forces fed to the plate). For each
 ball: first-impact restitution, peak force, contact duration, bounces within the run, rest time.
 
 Zener (1941): a ball on an infinite plate loses the energy the plate radiates, set by the
-inelasticity lambda (tailbeam.coupled.zener). With c = 0 the study checks our restitution at the
-plate centre against the Zener ODE, and then asks whether the ranking of energy loss between
+inelasticity lambda (tailbeam.solvers.coupled.zener). With c = 0 the study checks our restitution at
+the plate centre against the Zener ODE, and then asks whether the ranking of energy loss between
 coal and sandstone (rigid plate: set by the contact damping c) survives on the flexible plate.
 
 Finally one accelerometer (0, 0.15) m, 51.2 kHz, records coal and sandstone dropped alone at the
@@ -24,15 +24,15 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
-from tailbeam.coupled import simulate_coupled
-from tailbeam.coupled.zener import point_impedance, zener_impact
-from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
-from tailbeam.rigid import simulate_rigid
-from tailbeam.scenarios import SCENARIOS
+from tailbeam.paper.scenarios import SCENARIOS
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.scene import ContactSettings, SensorSpec
+from tailbeam.solvers.coupled import simulate_coupled
+from tailbeam.solvers.coupled.zener import point_impedance, zener_impact
+from tailbeam.solvers.rigid import simulate_rigid
 
 FMAX_HZ = 20000.0
 SENSOR = SensorSpec("S1", (0.0, 0.15))

@@ -8,8 +8,8 @@ analogues of the paper's Figs. 2-10 (only when run as a script).
     python examples/paper_reproduction.py
 """
 
-from tailbeam import claims as claims_mod
-from tailbeam.scenarios import SCENARIOS, run_all
+from tailbeam.paper import claims as claims_mod
+from tailbeam.paper.scenarios import SCENARIOS, run_all
 from tailbeam.scene import ContactSettings
 
 
@@ -34,7 +34,7 @@ def visualize(results, out_dir="out/paper_reproduction"):
     """Write the position, velocity and force figures of every scenario to ``out_dir``."""
     from pathlib import Path
 
-    from tailbeam.figures import scenario_figures
+    from tailbeam.paper.figures import scenario_figures
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -64,8 +64,8 @@ def configure_numba_cache() -> Path:
 
 def announce_first_compile(solver: str = "rigid") -> None:
     """Say so (tailbeam.progress.note) when numba's cache holds no compiled kernel of
-    ``solver`` (``"rigid"`` or ``"coupled"``, numba names its cache folders after the source
-    folder): the first run compiles them (10-20 s), later runs load them from the cache."""
+    ``solver`` (``"rigid"``, ``"coupled"`` or ``"stream"``, numba names its cache folders after the
+    source folder): the first run compiles them (10-20 s), later runs load them from the cache."""
     folder = Path(os.environ.get("NUMBA_CACHE_DIR") or numba_cache_dir())
     if not any(folder.glob(f"{solver}*/*.nbi")):
         from tailbeam.progress import note

@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tailbeam.bodies import Plate
-from tailbeam.contact_patch import disc_rule
 from tailbeam.errors import InputError
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.contact_patch import disc_rule
 
 PointEvaluator = Callable[[np.ndarray], np.ndarray]
 NAVIER_TERMS = 2000  # per direction
@@ -80,7 +80,7 @@ class ModalBasis:
 
     def load_deflection(self, points, contact_radius: float = 0.0) -> np.ndarray:
         """(p, n) modal deflections averaged over a disc of ``contact_radius`` m about each
-        point (tailbeam.contact_patch.disc_rule; radius 0: at the point): the modal force of
+        point (tailbeam.physics.contact_patch.disc_rule; radius 0: at the point): the modal force of
         a unit load spread over the disc, and the mean plate deflection there."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
         if contact_radius == 0.0:

@@ -7,7 +7,7 @@ hang or allocate without bound is refused in milliseconds, before the solver sta
 
 Rules (and why):
 - Penetration: the undamped (upper-bound) maximum penetration of every ball's hardest impact
-  (speed after falling from its start, tailbeam.hertz) must stay below
+  (speed after falling from its start, tailbeam.physics.hertz) must stay below
   ``MAX_PENETRATION_FRACTION`` of its radius. Hertz theory, which gives k, assumes small
   deformation; far beyond that the law is used outside its validity (an exponent of 1e6
   makes the force vanish below 1 m of penetration).
@@ -25,7 +25,7 @@ Rules (and why):
 import math
 
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.hertz import hertz_max_penetration
+from tailbeam.physics.hertz import hertz_max_penetration
 
 MAX_PENETRATION_FRACTION = 0.1  # of the ball radius
 MAX_CONTACT_DAMPING_RATIO = 1e4
@@ -113,7 +113,7 @@ def check_streams(scene) -> None:
     WorkLimitError names the setting to change."""
     if not scene.needs_stream_solver:
         return
-    from tailbeam.solvers.engine import stream_engine
+    from tailbeam.solvers.stream.engine import stream_engine
 
     engine = stream_engine()
     _check_particle_count(scene, engine, sum(scene.expected_particles()), "expects")

@@ -4,11 +4,11 @@ In the spirit of scipy's ``OdeResult`` and diffrax's ``Solution``: one interface
 filled by the solver that ran. ``Result`` implements everything common once; the solvers'
 results are thin subclasses that add only what is theirs:
 
-- ``tailbeam.rigid.RigidResult`` (rigid plate, balls that cannot touch) and
-  ``tailbeam.coupled.CoupledResult`` (modal plate; adds the modal replay ``modal_sample``,
+- ``tailbeam.solvers.rigid.RigidResult`` (rigid plate, balls that cannot touch) and
+  ``tailbeam.solvers.coupled.CoupledResult`` (modal plate; adds the modal replay ``modal_sample``,
   ``plate_sample``, the sensors), both through ``BallsResult`` (the single-ball solvers:
   ``impacts`` as ``Impact`` records, ``sample(times)`` exact at any times, ``rest_time``);
-- ``tailbeam.solvers.stream_result.StreamResult`` (streams, an inclined plate, balls that
+- ``tailbeam.solvers.stream.stream_result.StreamResult`` (streams, an inclined plate, balls that
   may touch; keeps its records only, so no ``sample``).
 
 Common interface (every result):
@@ -20,7 +20,7 @@ Common interface (every result):
   ``particles_table()`` (particles.csv, ``PARTICLE_COLUMNS``: one row per ball, streams
   and ``[[balls]]`` alike), ``impacts_of(name)``, ``events_of(name, kind)``, ``leaves``;
 - ``sample(times)`` (ball states; single-ball solvers only), ``time_grid(rate)``;
-- ``sensor_outputs`` (name -> ``tailbeam.sensor.SensorOutput``; empty on the rigid plate),
+- ``sensor_outputs`` (name -> ``tailbeam.signals.sensor.SensorOutput``; empty on the rigid plate),
   ``sensor_signals`` (name -> (t s, acceleration m/s^2)).
 
 Columns of ``impacts_table()`` (one row per ball per contact; a ball-ball contact gives one
@@ -161,7 +161,8 @@ class Result:
 
     @property
     def sensor_outputs(self) -> dict:
-        """name -> ``tailbeam.sensor.SensorOutput`` of every sensor (none on a rigid plate)."""
+        """name -> ``tailbeam.signals.sensor.SensorOutput`` of every sensor (none on a rigid
+        plate)."""
         return {}
 
     @property
@@ -172,10 +173,10 @@ class Result:
 
 class BallsResult(Result):
     """The single-ball solvers' common part (rigid and modal plate): ``impacts`` are
-    ``tailbeam.rigid.Impact`` records, ``events`` (t, ball, kind) triples, the balls move
+    ``tailbeam.solvers.rigid.Impact`` records, ``events`` (t, ball, kind) triples, the balls move
     laterally at their constant initial velocity. A subclass provides ``balls``,
     ``labels`` (one per ball; empty: ``tailbeam.scene.default_label``), ``_plate()`` (the
-    ``tailbeam.bodies.Plate``, or None when unknown) and ``nfev``, ``n_steps``."""
+    ``tailbeam.physics.bodies.Plate``, or None when unknown) and ``nfev``, ``n_steps``."""
 
     keeps_states = True
 

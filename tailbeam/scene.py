@@ -1,32 +1,32 @@
 """A scene in memory: what to simulate (balls, plate, contact settings, sensors).
 
-Reading scene files lives in ``tailbeam.scene_file``; this module holds no I/O.
+Reading scene files lives in ``tailbeam.io.scene_file``; this module holds no I/O.
 """
 
 import functools
 import math
 from dataclasses import dataclass, field
 
-from tailbeam.bodies import STANDARD_GRAVITY, Ball, Plate
-from tailbeam.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
 from tailbeam.errors import (
     InputError,
     require_nonnegative,
     require_positive,
     require_vector,
 )
-from tailbeam.materials import Material
-from tailbeam.noise import NoiseSpec
+from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, Plate
+from tailbeam.physics.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
+from tailbeam.physics.materials import Material
+from tailbeam.signals.noise import NoiseSpec
 
 # Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams'
-# default penetration depth. c = 300 N s/m was chosen by running the paper's three scenarios over
-# a grid of (c, d, drop gap) and keeping every qualitative claim of sections 4.1-4.3 and
-# conclusions 1-3 true (tailbeam.claims, benchmarks/claim_map.py): with d = 0.1 mm all claims hold
-# on the grid for c = 300-350 N s/m at every drop gap 0-10 mm, and c = 300 is the one grid value
-# that also holds at 20 mm. The binding claim is 4.3 (coal rebounds above sandstone after
-# collisions 1-2 and below from the 3rd), which needs e_sand / e_coal of about 1.1. At ~1 m/s c =
-# 300 gives restitution 0.84 (coal) and 0.92 (sandstone) on steel; Adams' own default, c = 10 N
-# s/mm, makes coal nearly plastic (e ~ 0.1) and breaks 4.3 and 4.1.
+# default penetration depth. c = 300 N s/m was chosen by running the paper's three scenarios over a
+# grid of (c, d, drop gap) and keeping every qualitative claim of sections 4.1-4.3 and conclusions
+# 1-3 true (tailbeam.paper.claims, benchmarks/claim_map.py): with d = 0.1 mm all claims hold on the
+# grid for c = 300-350 N s/m at every drop gap 0-10 mm, and c = 300 is the one grid value that also
+# holds at 20 mm. The binding claim is 4.3 (coal rebounds above sandstone after collisions 1-2 and
+# below from the 3rd), which needs e_sand / e_coal of about 1.1. At ~1 m/s c = 300 gives
+# restitution 0.84 (coal) and 0.92 (sandstone) on steel; Adams' own default, c = 10 N s/mm, makes
+# coal nearly plastic (e ~ 0.1) and breaks 4.3 and 4.1.
 DEFAULT_DAMPING = 300.0  # c, N s/m
 DEFAULT_PENETRATION = 1e-4  # d, m (Adams' default 0.1 mm)
 
@@ -79,7 +79,7 @@ class ModalPlateSettings:
     coupling: "two-way" or "one-way" (rigid-plate forces applied to the plate).
     tail: how the truncated modes act at a contact: "quasi-static" (their static compliance),
     "ritz" (load-dependent Ritz pseudo-modes at the balls' first contact points,
-    tailbeam.coupled.ritz_prepass; needs residual_flexibility and two-way coupling) or
+    tailbeam.solvers.coupled.ritz_prepass; needs residual_flexibility and two-way coupling) or
     "auto" (the default: "ritz" where it applies, the coupled solver on an FE basis with
     both; "quasi-static" elsewhere, saying why).
     tail_modes: Ritz pseudo-modes per contact point, a whole number >= 1 (default 32:
@@ -159,7 +159,7 @@ class SensorSpec:
     sample_rate: float = 51200.0
     bandwidth_hz: float | None = None
     mounted_resonance_hz: float | None = None
-    noise: NoiseSpec | None = None  # measurement noise added to the output (tailbeam.noise)
+    noise: NoiseSpec | None = None  # measurement noise added to the output (tailbeam.signals.noise)
 
     def __post_init__(self):
         field_ = f"sensors[{self.name}]"

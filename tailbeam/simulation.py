@@ -5,12 +5,12 @@ progress) is keyword-only. It returns one result type, ``tailbeam.result.Result`
 solver the scene chooses:
 
 - rigid plate, no streams, no inclination, no two balls that can touch (their horizontal
-  paths never come within the sum of the radii): ``tailbeam.rigid.simulate_rigid``, exact
+  paths never come within the sum of the radii): ``tailbeam.solvers.rigid.simulate_rigid``, exact
   per ball (its ``Result`` is a ``RigidResult``);
 - modal plate with balls only: the coupled modal solver
-  (``tailbeam.coupled.simulate_scene_modal``, a ``CoupledResult``);
+  (``tailbeam.solvers.coupled.simulate_scene_modal``, a ``CoupledResult``);
 - otherwise (streams, an inclined plate, balls that may touch): the stream solver of
-  ``tailbeam.solvers.engine`` (a ``StreamResult``), on the rigid or the modal plate.
+  ``tailbeam.solvers.stream.engine`` (a ``StreamResult``), on the rigid or the modal plate.
 """
 
 import contextlib
@@ -28,7 +28,7 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
     Parameters
     ----------
     scene : tailbeam.scene.Scene
-        What to simulate (e.g. from ``tailbeam.scene_file.load_scene``).
+        What to simulate (e.g. from ``tailbeam.io.scene_file.load_scene``).
     rtol : float, optional
         Relative tolerance of the solver (rigid: its default 1e-10; stream reference 1e-10).
     max_steps : int, optional
@@ -54,7 +54,7 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
     how = {k: v for k, v in (("rtol", rtol), ("max_steps", max_steps)) if v is not None}
     with contextlib.nullcontext() if progress else quiet():
         if scene.needs_stream_solver:
-            from tailbeam.coupled.ritz_prepass import check_tail_scene
+            from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene
 
             check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
             if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
@@ -72,7 +72,7 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
 
 
 def _rigid(scene, how):
-    from tailbeam.rigid import simulate_rigid
+    from tailbeam.solvers.rigid import simulate_rigid
 
     with task(f"simulating {scene.duration:g} s, {len(scene.balls)} balls, rigid plate"):
         return simulate_rigid(
@@ -81,7 +81,7 @@ def _rigid(scene, how):
 
 
 def _modal(scene, how):
-    from tailbeam.coupled import simulate_scene_modal
+    from tailbeam.solvers.coupled import simulate_scene_modal
 
     if how:
         raise InputError(next(iter(how)), "is not a setting of the modal plate solver")
@@ -92,7 +92,7 @@ def _modal(scene, how):
 
 def _stream(scene, how, plate=None):
     from tailbeam.preflight import check_streams
-    from tailbeam.solvers.engine import stream_engine
+    from tailbeam.solvers.stream.engine import stream_engine
 
     check_streams(scene)  # (already done by load_scene; a Scene built in Python needs it)
     engine = stream_engine()
@@ -127,7 +127,7 @@ def stream_band(scene) -> dict:
     """The modal band of a stream scene: plate.fmax, else the sensors' bandwidth (at least
     STREAM_MIN_BAND_HZ), and the coupling (plate.coupling: two-way by default)."""
     from tailbeam.scene import ModalPlateSettings
-    from tailbeam.sensor import resolve
+    from tailbeam.signals.sensor import resolve
 
     settings = scene.modal or ModalPlateSettings()
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
@@ -147,9 +147,9 @@ def stream_band(scene) -> dict:
 
 
 def _basis_and_damping(scene, band):
-    from tailbeam.coupled.auto import build_basis
-    from tailbeam.coupled.solver import modal_damping
     from tailbeam.scene import ModalPlateSettings
+    from tailbeam.solvers.coupled.auto import build_basis
+    from tailbeam.solvers.coupled.solver import modal_damping
 
     settings = scene.modal or ModalPlateSettings()
     basis = build_basis(scene, band)
@@ -157,9 +157,9 @@ def _basis_and_damping(scene, band):
 
 
 def _stream_plate(scene, band):
-    """The two-way modal plate of a stream scene (tailbeam.solvers.stream_plate)."""
+    """The two-way modal plate of a stream scene (tailbeam.solvers.stream.stream_plate)."""
     from tailbeam.scene import ModalPlateSettings
-    from tailbeam.solvers.stream_plate import StreamPlate
+    from tailbeam.solvers.stream.stream_plate import StreamPlate
 
     basis, zeta = _basis_and_damping(scene, band)
     settings = scene.modal or ModalPlateSettings()
@@ -169,11 +169,11 @@ def _stream_plate(scene, band):
 def _modal_sensors(scene, result, band, plate):
     """The sensors of a stream on the modal plate: the stream's plate forces (two-way, or
     one-way from the rigid plate: ``result.loads``) drive the modes exactly; the sensors read
-    the plate there (tailbeam.coupled.load_response)."""
-    from tailbeam.coupled.auto import _choices
-    from tailbeam.coupled.load_response import sensor_outputs
-    from tailbeam.coupled.loads import PlateLoads
+    the plate there (tailbeam.solvers.coupled.load_response)."""
     from tailbeam.scene import ModalPlateSettings
+    from tailbeam.solvers.coupled.auto import _choices
+    from tailbeam.solvers.coupled.load_response import sensor_outputs
+    from tailbeam.solvers.coupled.loads import PlateLoads
 
     settings = scene.modal or ModalPlateSettings()
     if plate is None:

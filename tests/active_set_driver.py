@@ -1,6 +1,7 @@
 """A minimal driver for tests: every ball of a small scene in ONE active set, all pairs watched,
 restarted after every event; writes the same ContactRecord / LeaveEvent as the stream
-reference (not a test module; the fast solver's real driver is tailbeam/solvers/stream.py)."""
+reference (not a test module; the fast solver's real driver is
+tailbeam/solvers/stream/stream.py)."""
 
 import math
 
@@ -8,8 +9,8 @@ import numpy as np
 
 from tailbeam.physics.incline import EDGES
 from tailbeam.physics.pair import pair_kinematics, plate_foot
-from tailbeam.solvers.active_set import ActiveSet
 from tailbeam.solvers.records import PLATE, ContactRecord, LeaveEvent
+from tailbeam.solvers.stream.active_set import ActiveSet
 
 
 def reference_pairs(n):

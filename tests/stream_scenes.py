@@ -3,14 +3,14 @@
 import math
 
 from tailbeam import COAL, SANDSTONE, Ball, ball_plate_law
-from tailbeam.materials import CARBON_STEEL
+from tailbeam.physics.materials import CARBON_STEEL
 
 MIN_APPROACH = 0.1  # m/s: an impact approaches faster than this
 
 
 def static_penetration_on(material, radius, incline) -> float:
     """Penetration in m at which a ball of ``material``, ``radius`` rests on ``incline``
-    (normal force m g cos theta; the closed form of tailbeam.hertz)."""
+    (normal force m g cos theta; the closed form of tailbeam.physics.hertz)."""
     law = ball_plate_law(material, radius, CARBON_STEEL)
     ball = Ball("probe", material, radius, (0.0, 0.0, 1.0))
     normal_load = ball.mass * incline.gravity * math.cos(math.radians(incline.inclination))

@@ -1,7 +1,8 @@
-"""The compiled active-set integrator (tailbeam.solvers.active_set) against independent truths:
-the rigid-plate solver (tailbeam.rigid, its own 1-D kernel), Johnson's Hertz closed forms
-(tailbeam.hertz), conservation laws, the closed-form slide on the frictionless incline, and
-the slow scipy stream reference (tailbeam.solvers.stream_reference) on the shared scenes.
+"""The compiled active-set integrator (tailbeam.solvers.stream.active_set) against independent
+truths: the rigid-plate solver (tailbeam.solvers.rigid, its own 1-D kernel), Johnson's Hertz closed
+forms (tailbeam.physics.hertz), conservation laws, the closed-form slide on the frictionless
+incline, and the slow scipy stream reference (tailbeam.solvers.stream.stream_reference) on the
+shared scenes.
 
 Tolerances are the brief's (1e-10 vs the rigid solver, 1e-8 Hertz, 1e-12 momentum, 1e-9
 energy, 1e-6 vs the reference); the measured values are in the docstrings.
@@ -16,11 +17,11 @@ from active_set_driver import SceneRun
 from numpy.polynomial import chebyshev as cheb
 
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_ball_law, ball_plate_law
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.rigid import simulate_rigid
-from tailbeam.solvers import cheb_events, step_events
-from tailbeam.solvers.active_set import ActiveSet
+from tailbeam.solvers.rigid import simulate_rigid
+from tailbeam.solvers.stream import cheb_events, step_events
+from tailbeam.solvers.stream.active_set import ActiveSet
 
 NO_GRAVITY = InclinedPlate(gravity=0.0)
 
@@ -36,7 +37,7 @@ def _single(ball, law, incline, rtol=1e-12):
 def test_ball_plate_contact_matches_rigid_solver(damping, exponent):
     """One coal ball dropped on the horizontal plate (g along -z), c = 0 and c = 800 N s/m
     (STEP ramp, clamp), exponents 1.5, 1 and 2.2: t_start, t_end, v_out, peak force, t_peak,
-    max penetration and the kink times of the first two contacts equal tailbeam.rigid's (its
+    max penetration and the kink times of the first two contacts equal tailbeam.solvers.rigid's (its
     own DOP853 kernel on the 1-D contact ODE, 1e-11 from its closed forms) to 1e-10
     (measured <= 2e-11; the largest is the start time after the flight)."""
     r, g = 0.03, 9.81
@@ -231,7 +232,7 @@ def _scene_pair(name):
     after every event by the test driver) on a shared scene, rtol 1e-12 both."""
     from stream_scenes import leave_scene, ten_ball_scene
 
-    from tailbeam.solvers.stream_reference import simulate_stream_reference
+    from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
 
     which, theta, damping, duration = SCENES[name]
     incline = InclinedPlate(inclination=theta)
@@ -313,7 +314,7 @@ def test_energy_over_a_ten_ball_run(ten_balls):
 
 def test_force_rows_interpolate_the_force():
     """The plate force rows (step ends, DEFAULT_NODES interior points, start/end) linearly
-    interpolated reproduce the contact force of tailbeam.rigid's exact dense evaluation
+    interpolated reproduce the contact force of tailbeam.solvers.rigid's exact dense evaluation
     (RigidResult.sample) to 1e-5 of the peak at rtol 1e-10 (measured 7e-6 with c = 0 and
     8e-6 with c = 800; the error falls as (nodes + 1)^-2)."""
     r, g = 0.03, 9.81
@@ -341,7 +342,7 @@ def test_settle_event():
     penetration): below it at the event, above it at every earlier return (1 ms apart, and
     every event) where the ball touched the plate. A two-ball stack with settle energies (each
     ball touches two pairs or no plate) never settles."""
-    from tailbeam.contact_law import elastic_energy
+    from tailbeam.physics.contact_law import elastic_energy
 
     incline = InclinedPlate()
     g = incline.gravity

@@ -1,19 +1,20 @@
-"""The automatic modal band (tailbeam.coupled.auto): its estimates against independent truths
-(the SSSS closed-form static compliance and exact SSSS modes), its choice, and its refusals."""
+"""The automatic modal band (tailbeam.solvers.coupled.auto): its estimates against independent
+truths (the SSSS closed-form static compliance and exact SSSS modes), its choice, and its
+refusals."""
 
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Ball, Plate
 from tailbeam.cli import main
-from tailbeam.contact_law import ball_plate_law
-from tailbeam.coupled import auto, simulate_coupled
 from tailbeam.errors import InputError
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
-from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
+from tailbeam.io.scene_file import loads_scene
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.plate.closed_forms import ssss_static_compliance
-from tailbeam.scene_file import loads_scene
+from tailbeam.solvers.coupled import auto, simulate_coupled
 
 PLATE = Plate()
 SCENE = """
@@ -54,7 +55,7 @@ def test_residual_compliance_estimate_matches_ssss_closed_form(f_cut):
 
 
 def test_undamped_pulse_matches_hertz_closed_forms():
-    # Truth: Johnson's closed forms (tailbeam.hertz) for an undamped impact on a rigid flat.
+    # Truth: Johnson's closed forms (tailbeam.physics.hertz) for an undamped impact on a rigid flat.
     law = ball_plate_law(SANDSTONE, 0.02, CARBON_STEEL)
     mass = Ball("b", SANDSTONE, 0.02, (0.0, 0.0, 0.03)).mass
     pulse = auto.impact_pulse(mass, 2.0, law)

@@ -5,7 +5,7 @@ import math
 import pytest
 
 from tailbeam import CARBON_STEEL, COAL, Ball, InputError, Material, Plate, get_material
-from tailbeam.bodies import check_ball_above_plate
+from tailbeam.physics.bodies import check_ball_above_plate
 
 
 def test_ball_mass_and_plate_rigidity_by_hand():

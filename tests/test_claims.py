@@ -1,18 +1,18 @@
 """The paper's qualitative claims (sec. 4.1-4.3, conclusions 1-3) at the default settings.
 
-Each claim is checked against its stated threshold (tailbeam.claims); the thresholds are set by
-the meaning of the paper's words, not by the simulation (see each claim's docstring).
+Each claim is checked against its stated threshold (tailbeam.paper.claims); the thresholds are set
+by the meaning of the paper's words, not by the simulation (see each claim's docstring).
 """
 
 import math
 
 import pytest
 
-from tailbeam import claims
-from tailbeam.materials import COAL, SANDSTONE
-from tailbeam.rigid.reference import simulate_rigid_reference
-from tailbeam.scenarios import ENERGY, SCENARIOS, equal_energy_speed, run_all, run_scenario
+from tailbeam.paper import claims
+from tailbeam.paper.scenarios import ENERGY, SCENARIOS, equal_energy_speed, run_all, run_scenario
+from tailbeam.physics.materials import COAL, SANDSTONE
 from tailbeam.scene import ContactSettings
+from tailbeam.solvers.rigid.reference import simulate_rigid_reference
 
 
 @pytest.fixture(scope="module")

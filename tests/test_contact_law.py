@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, InputError
-from tailbeam.contact_law import (
+from tailbeam.physics.contact_law import (
     ImpactLaw,
     ball_ball_law,
     ball_plate_law,
@@ -15,7 +15,7 @@ from tailbeam.contact_law import (
     step,
     step_scalar,
 )
-from tailbeam.materials import effective_modulus
+from tailbeam.physics.materials import effective_modulus
 
 
 def test_step_endpoints_and_c1_continuity():

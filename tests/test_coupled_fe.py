@@ -1,6 +1,6 @@
 """The modal solver against the project's full finite-element reference
-(tailbeam.coupled.fe_reference: every DOF of the same mesh, Newmark average acceleration, the
-IMPACT law solved implicitly each step).
+(tailbeam.solvers.coupled.fe_reference: every DOF of the same mesh, Newmark average acceleration,
+the IMPACT law solved implicitly each step).
 
 Configuration (why it is not the default plate mesh): the tests compare the modal solver with
 the FE system of the SAME mesh and element, so a coarser mesh is a legitimate, affordable
@@ -14,13 +14,13 @@ no FE damping matrix; Rayleigh damping, which has one, is checked separately). S
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
-from tailbeam.coupled.fe_compare import Case, modal_errors, observed_order
-from tailbeam.coupled.fe_reference import QUANTITIES, fe_time_step_study
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.materials import CARBON_STEEL, SANDSTONE
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.materials import CARBON_STEEL, SANDSTONE
 from tailbeam.plate import assemble_plate, compute_modes
+from tailbeam.solvers.coupled.fe_compare import Case, modal_errors, observed_order
+from tailbeam.solvers.coupled.fe_reference import QUANTITIES, fe_time_step_study
 
 R = 0.03
 IMPACT, SENSOR = (0.05, 0.03), (0.05, 0.10)

@@ -9,14 +9,14 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Ball, Plate
-from tailbeam.contact_law import ball_plate_law
-from tailbeam.coupled import simulate_coupled
-from tailbeam.coupled.zener import point_impedance, zener_impact
-from tailbeam.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.modal import ssss_kirchhoff_basis
-from tailbeam.rigid import simulate_rigid
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.scene import ContactSettings
+from tailbeam.solvers.coupled import simulate_coupled
+from tailbeam.solvers.coupled.zener import point_impedance, zener_impact
+from tailbeam.solvers.rigid import simulate_rigid
 
 R = 0.03
 

@@ -1,5 +1,5 @@
 """``plate.tail = "ritz"``: the coupled solver with Ritz pseudo-modes at the balls' first
-contact points (tailbeam.coupled.ritz_prepass), against the full-FE reference of
+contact points (tailbeam.solvers.coupled.ritz_prepass), against the full-FE reference of
 tests/test_coupled_fe.py (same meshes, ball, sensor), plus the scene key and its bad input."""
 
 import math
@@ -9,15 +9,19 @@ from test_cli import tailbeam
 from test_coupled_fe import IMPACT, MESHES, SENSOR, R, _basis, runs  # noqa: F401 (fixture)
 
 import tailbeam as tb
-from tailbeam.bodies import Ball, Plate
-from tailbeam.coupled.auto import simulate_scene_modal
-from tailbeam.coupled.fe_compare import result_errors
-from tailbeam.coupled.ritz_prepass import first_contact_time, first_contacts, ritz_tail_basis
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.materials import SANDSTONE
+from tailbeam.io.scene_file import loads_scene, scene_to_dict
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Ball, Plate
+from tailbeam.physics.materials import SANDSTONE
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
-from tailbeam.scene_file import loads_scene, scene_to_dict
+from tailbeam.solvers.coupled.auto import simulate_scene_modal
+from tailbeam.solvers.coupled.fe_compare import result_errors
+from tailbeam.solvers.coupled.ritz_prepass import (
+    first_contact_time,
+    first_contacts,
+    ritz_tail_basis,
+)
 
 BAND = 20000.0
 

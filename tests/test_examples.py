@@ -3,7 +3,7 @@
 import importlib.util
 from pathlib import Path
 
-from tailbeam.scene_file import load_scene
+from tailbeam.io.scene_file import load_scene
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 

@@ -13,11 +13,11 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.text import Text
 
 from benchmarks.claim_map import QUICK
-from tailbeam import figures
-from tailbeam.results_io import write_impacts_csv
-from tailbeam.scenarios import SCENARIOS, run_scenario
-from tailbeam.sensor import SensorChain, SensorOutput, amplitude_spectrum
-from tailbeam.sensor_figures import build_sensor_figure, sensor_stats, welch_psd
+from tailbeam.io.results_io import write_impacts_csv
+from tailbeam.paper import figures
+from tailbeam.paper.scenarios import SCENARIOS, run_scenario
+from tailbeam.signals.sensor import SensorChain, SensorOutput, amplitude_spectrum
+from tailbeam.signals.sensor_figures import build_sensor_figure, sensor_stats, welch_psd
 
 
 def render(fig):

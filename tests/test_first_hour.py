@@ -17,7 +17,7 @@ import pytest
 import tailbeam
 from tailbeam.cachedir import source_fingerprint
 from tailbeam.cli import main
-from tailbeam.hertz import free_fall_apex
+from tailbeam.physics.hertz import free_fall_apex
 
 ROOT = Path(__file__).resolve().parents[1]
 RIGID = (ROOT / "examples" / "two_balls_rigid.toml").read_text()
@@ -46,7 +46,7 @@ def test_numba_cache_lives_outside_the_package(tmp_path):
     env = dict(os.environ, TAILBEAM_CACHE_DIR=str(tmp_path))
     env.pop("NUMBA_CACHE_DIR", None)
     code = (
-        "import tailbeam, numba; from tailbeam.scenarios import run_all; run_all(); "
+        "import tailbeam, numba; from tailbeam.paper.scenarios import run_all; run_all(); "
         "print(numba.config.CACHE_DIR)"
     )
     out = subprocess.run(
@@ -75,7 +75,7 @@ def test_numba_cache_follows_every_source_file(tmp_path):
 
     before = fingerprint()
     assert before == source_fingerprint()  # same sources, same folder (another checkout too)
-    helper = package / "solvers" / "active_pairs.py"
+    helper = package / "solvers" / "stream" / "active_pairs.py"
     helper.write_text(helper.read_text() + "\n# edited\n")
     assert fingerprint() != before
 
@@ -257,7 +257,7 @@ def test_a_run_replaces_the_folder_whole(tmp_path, capsys):
 @pytest.mark.parametrize("gravity", [1.62, 9.80665, 24.79])
 def test_gravity_key_matches_the_closed_form_fall(gravity, tmp_path, capsys):
     """Impact time of a ball dropped from rest at gap h: sqrt(2 h / g); the apex after the
-    first rebound is v_out^2 / (2 g) (tailbeam.hertz.free_fall_apex)."""
+    first rebound is v_out^2 / (2 g) (tailbeam.physics.hertz.free_fall_apex)."""
     text = RIGID.replace("duration = 1.0 ", f"gravity = {gravity!r}\nduration = 1.0 ")
     text = text.replace("velocity = [0.0, 0.0, -1.0]", "velocity = [0.0, 0.0, 0.0]")
     scene = tmp_path / "g.toml"

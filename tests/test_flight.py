@@ -1,11 +1,11 @@
-"""Closed-form motion between contacts (tailbeam.solvers.flight) against closed forms."""
+"""Closed-form motion between contacts (tailbeam.solvers.stream.flight) against closed forms."""
 
 import math
 
 import numpy as np
 import pytest
 
-from tailbeam.solvers.flight import (
+from tailbeam.solvers.stream.flight import (
     band_time,
     edge_time,
     first_crossing,

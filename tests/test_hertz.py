@@ -1,4 +1,4 @@
-"""Closed forms of the undamped impact (tailbeam.hertz) against independent derivations."""
+"""Closed forms of the undamped impact (tailbeam.physics.hertz) against independent derivations."""
 
 import math
 
@@ -6,7 +6,7 @@ import pytest
 from scipy.integrate import quad
 
 from tailbeam.errors import InputError
-from tailbeam.hertz import (
+from tailbeam.physics.hertz import (
     free_fall_apex,
     hertz_contact_duration,
     hertz_duration_factor,

@@ -137,7 +137,7 @@ def test_the_law_is_written_once():
 
 def test_event_kinds_print_as_their_values_and_every_solver_uses_them():
     from tailbeam import CARBON_STEEL, COAL, Ball, Plate, ball_plate_law
-    from tailbeam.rigid import EVENT_KINDS, simulate_rigid
+    from tailbeam.solvers.rigid import EVENT_KINDS, simulate_rigid
 
     assert f"{EventKind.REST}" == str(EventKind.REST) == EventKind.REST == "rest"
     assert set(EVENT_KINDS) <= set(EventKind)

@@ -6,7 +6,7 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.text import Text
 
-from tailbeam.bodies import Plate
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate import compute_modes
 from tailbeam.plate.closed_forms import ssss_modes
 from tailbeam.plate.export import build_modes_figure, write_png

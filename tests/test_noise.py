@@ -1,14 +1,14 @@
-"""The sensor noise model (tailbeam.noise, scene key [[sensors]] noise): its RMS and band
+"""The sensor noise model (tailbeam.signals.noise, scene key [[sensors]] noise): its RMS and band
 against their definitions, reproducibility from the seed, and the scene-file key."""
 
 import numpy as np
 import pytest
 
 from tailbeam.errors import InputError
-from tailbeam.noise import NoiseSpec, band_limited_noise, noise
+from tailbeam.io.scene_file import dumps_scene, loads_scene
 from tailbeam.scene import SensorSpec
-from tailbeam.scene_file import dumps_scene, loads_scene
-from tailbeam.sensor import measure
+from tailbeam.signals.noise import NoiseSpec, band_limited_noise, noise
+from tailbeam.signals.sensor import measure
 
 FS = 20000.0
 N = 200_000

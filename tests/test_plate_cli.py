@@ -5,9 +5,9 @@ import csv
 import meshio
 import numpy as np
 
-from tailbeam.bodies import Plate
 from tailbeam.cli import main
-from tailbeam.output import MANIFEST
+from tailbeam.io.output import MANIFEST
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate.closed_forms import ssss_modes
 
 

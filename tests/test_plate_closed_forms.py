@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from tailbeam.bodies import Plate
-from tailbeam.materials import Material
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.materials import Material
 from tailbeam.plate.closed_forms import (
     SHEAR_COEFFICIENT,
     bending_wavenumber,

@@ -10,8 +10,8 @@ series converges slowly from above). Run at nu = 0.3 as the free-edge tables ass
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Plate
-from tailbeam.materials import Material
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.materials import Material
 from tailbeam.plate import compute_modes
 from tailbeam.plate.closed_forms import LEISSA_SQUARE, leissa_frequencies
 

@@ -9,7 +9,7 @@ checks pin down the C and F DOF choices to 1e-4, far tighter than Leissa's table
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Plate
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate import compute_modes
 from tailbeam.plate.closed_forms import kirchhoff_model_error, levy_frequencies, ssss_modes
 

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from skfem import MeshTri
 
-from tailbeam.bodies import Plate
 from tailbeam.errors import InputError
-from tailbeam.materials import Material
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.materials import Material
 from tailbeam.plate import compute_modes, load_mesh, save_mesh, structured_mesh
 from tailbeam.plate.cache import cache_key
 from tailbeam.plate.closed_forms import levy_frequencies

@@ -8,7 +8,7 @@ benchmarks/bench_modes.py).
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Plate
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate import assemble_plate, compute_modes
 from tailbeam.plate.closed_forms import ssss_mode_count, ssss_modes
 from tailbeam.plate.sparse_solve import count_eigenvalues_below

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from tailbeam.bodies import Plate
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate import assemble_plate, compute_modes
 from tailbeam.plate.closed_forms import ssss_static_compliance
 

@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 
 import tailbeam
-from tailbeam.bodies import Ball
 from tailbeam.cli import main
 from tailbeam.errors import InputError
-from tailbeam.materials import COAL, SANDSTONE
+from tailbeam.io.scene_file import dumps_scene
+from tailbeam.physics.bodies import Ball
+from tailbeam.physics.materials import COAL, SANDSTONE
 from tailbeam.result import IMPACT_COLUMNS, IMPACT_TABLE_COLUMNS, PARTICLE_COLUMNS, Result
 from tailbeam.scene import ModalPlateSettings, Scene
-from tailbeam.scene_file import dumps_scene
-from tailbeam.solvers.engine import stream_engine
+from tailbeam.solvers.stream.engine import stream_engine
 
 G = 9.80665
 GAPS = {"c": 0.02, "s": 0.03, "m": 0.01}  # drop gaps h (m): lowest point above the plate

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from tailbeam import CARBON_STEEL, COAL, Ball, Plate, ball_plate_law
-from tailbeam.rigid import simulate_rigid
-from tailbeam.rigid.reference import simulate_rigid_reference
+from tailbeam.solvers.rigid import simulate_rigid
+from tailbeam.solvers.rigid.reference import simulate_rigid_reference
 
 RTOLS = [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
 

@@ -13,8 +13,8 @@ import pytest
 from scipy.integrate import simpson
 
 from tailbeam import CARBON_STEEL, COAL, Ball, ImpactLaw, Plate, ball_plate_law
-from tailbeam.bodies import STANDARD_GRAVITY as G
-from tailbeam.rigid import simulate_rigid
+from tailbeam.physics.bodies import STANDARD_GRAVITY as G
+from tailbeam.solvers.rigid import simulate_rigid
 
 R = 0.03
 PLATE = Plate()

@@ -1,6 +1,6 @@
 """The rigid solver against Johnson's closed forms (c = 0, g = 0: an undamped Hertz impact).
 
-Independent truth: tailbeam.hertz (energy balance and the Beta-function contact duration).
+Independent truth: tailbeam.physics.hertz (energy balance and the Beta-function contact duration).
 With rtol = 1e-11 the solver is expected within 1e-8 relative (the brief's bar); the measured
 errors are ~1e-12, so the bound has margin without being loose enough to hide a wrong order.
 """
@@ -8,8 +8,8 @@ errors are ~1e-12, so the bound has margin without being loose enough to hide a 
 import pytest
 
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, ImpactLaw, Plate, ball_plate_law
-from tailbeam.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
-from tailbeam.rigid import simulate_rigid
+from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
+from tailbeam.solvers.rigid import simulate_rigid
 
 GAP = 1e-3  # m between the ball and the plate at t = 0
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from tailbeam import CARBON_STEEL, COAL, Ball, InputError, Plate, WorkLimitError, ball_plate_law
-from tailbeam.rigid import Impact, RigidResult, simulate_rigid
-from tailbeam.rigid.reference import simulate_rigid_reference
+from tailbeam.solvers.rigid import Impact, RigidResult, simulate_rigid
+from tailbeam.solvers.rigid.reference import simulate_rigid_reference
 
 LAW = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0, penetration=1e-4)
 BALL = Ball("A", COAL, 0.03, (0.0, 0.0, 0.13), (0.0, 0.0, -1.0))

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from tailbeam import CARBON_STEEL, COAL, Ball, Plate, ball_plate_law
-from tailbeam.rigid import simulate_rigid
-from tailbeam.rigid.reference import simulate_rigid_reference
+from tailbeam.solvers.rigid import simulate_rigid
+from tailbeam.solvers.rigid.reference import simulate_rigid_reference
 
 LAW = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0, penetration=1e-4)
 PLATE = Plate()

@@ -7,8 +7,6 @@ import pytest
 from scipy import signal
 from test_coupled_fe import IMPACT, _basis, _case
 
-from tailbeam.coupled.fe_reference import QUANTITIES, impact_quantities
-from tailbeam.coupled.solver import simulate_coupled
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.plate.ritz_tail import (
     choose_ritz_k,
@@ -16,6 +14,8 @@ from tailbeam.plate.ritz_tail import (
     ritz_tail_modes,
     with_ritz_tail,
 )
+from tailbeam.solvers.coupled.fe_reference import QUANTITIES, impact_quantities
+from tailbeam.solvers.coupled.solver import simulate_coupled
 
 BAND = 20000.0
 

@@ -6,9 +6,9 @@ from pathlib import Path
 import pytest
 
 from tailbeam.errors import InputError
-from tailbeam.materials import COAL
+from tailbeam.io.scene_file import dumps_scene, load_scene, loads_scene, scene_to_dict
+from tailbeam.physics.materials import COAL
 from tailbeam.scene import DEFAULT_DAMPING, DEFAULT_PENETRATION, ModalPlateSettings
-from tailbeam.scene_file import dumps_scene, load_scene, loads_scene, scene_to_dict
 
 EXAMPLES = sorted((Path(__file__).parents[1] / "examples").glob("*.toml"))
 

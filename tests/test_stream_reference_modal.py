@@ -1,4 +1,4 @@
-"""The slow stream reference on the two-way MODAL plate (tailbeam.solvers.reference_plate)
+"""The slow stream reference on the two-way MODAL plate (tailbeam.solvers.stream.reference_plate)
 against independent truths, and the fast stream solver against it.
 
 - one ball on the closed-form SSSS plate: the two-way coupled single-ball solver without
@@ -21,14 +21,14 @@ from stream_scenes import modal_scene
 from test_stream_solver import _particles, _worst_difference
 
 from tailbeam import COAL, SANDSTONE, Ball, ball_plate_law
-from tailbeam.bodies import Plate
-from tailbeam.materials import CARBON_STEEL
 from tailbeam.modal import ssss_kirchhoff_basis
+from tailbeam.physics.bodies import Plate
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.solvers import active_members, stream
-from tailbeam.solvers.reference_plate import ReferencePlate
-from tailbeam.solvers.stream_plate import StreamPlate
-from tailbeam.solvers.stream_reference import simulate_stream_reference
+from tailbeam.physics.materials import CARBON_STEEL
+from tailbeam.solvers.stream import active_members, stream
+from tailbeam.solvers.stream.reference_plate import ReferencePlate
+from tailbeam.solvers.stream.stream_plate import StreamPlate
+from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
 
 FMAX = 1300.0  # Hz: 11 modes of the SSSS plate (the reference's steps follow the top mode)
 ZETA = 0.01
@@ -48,7 +48,7 @@ def test_single_ball_matches_the_coupled_solver(basis, damping):
     solver); the maximum penetration, which the coupled solver takes at its step nodes (a
     sampled maximum: below the true one), at most 1e-6 above b (measured 1.9e-7, 2.5e-8). The
     other four agree to 0.5-2e-9 (measured), the coupled error estimates are 1-7e-8."""
-    from tailbeam.coupled import simulate_coupled
+    from tailbeam.solvers.coupled import simulate_coupled
 
     r = 0.03
     ball = Ball("s", SANDSTONE, r, (0.07, -0.05, r + 1e-4), (0.0, 0.0, -2.0))
@@ -215,9 +215,9 @@ def test_gap_rows_are_polynomial_to_round_off_with_exact_shapes(basis, monkeypat
     1.5e-14): what the certificate and root search rely on."""
     from numpy.polynomial import chebyshev as cheb
 
-    from tailbeam.solvers import stream_reference as sr
     from tailbeam.solvers.records import EventKind
-    from tailbeam.solvers.step_events import STEP_POINTS, chebyshev_coefficients
+    from tailbeam.solvers.stream import stream_reference as sr
+    from tailbeam.solvers.stream.step_events import STEP_POINTS, chebyshev_coefficients
 
     worst, detect = [], sr._Reference.detect
     u = np.linspace(-1.0, 1.0, 101)

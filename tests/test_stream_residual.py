@@ -15,11 +15,11 @@ import pytest
 from scipy.optimize import brentq
 
 from tailbeam import SANDSTONE, Ball, ball_plate_law
-from tailbeam.materials import CARBON_STEEL
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.solvers import active_pairs as ap
-from tailbeam.solvers.stream import solve_stream
-from tailbeam.solvers.stream_plate import StreamPlate
+from tailbeam.physics.materials import CARBON_STEEL
+from tailbeam.solvers.stream import active_pairs as ap
+from tailbeam.solvers.stream.stream import solve_stream
+from tailbeam.solvers.stream.stream_plate import StreamPlate
 from tailbeam.streams.generator import Particle
 
 R = 0.03
@@ -27,8 +27,8 @@ BALL = Ball("s", SANDSTONE, R, (0.07, -0.05, R + 1e-4), (0.0, 0.0, -2.0))
 
 
 def _ssss(fmax):
-    from tailbeam.bodies import Plate
     from tailbeam.modal import ssss_kirchhoff_basis
+    from tailbeam.physics.bodies import Plate
 
     return ssss_kirchhoff_basis(Plate(), fmax)
 
@@ -47,7 +47,7 @@ def _stream_contact(basis, damping, residual, rtol=1e-12):
 
 
 def _coupled_contact(basis, damping, steps):
-    from tailbeam.coupled import simulate_coupled
+    from tailbeam.solvers.coupled import simulate_coupled
 
     law = ball_plate_law(SANDSTONE, R, CARBON_STEEL, damping=damping)
     res = simulate_coupled([BALL], basis, [law], 1e-3, gravity=InclinedPlate().gravity,

@@ -17,16 +17,16 @@ import numpy as np
 import pytest
 
 import tailbeam
-from tailbeam.bodies import Plate
 from tailbeam.cli import main
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.hertz import hertz_max_penetration, hertz_peak_force
-from tailbeam.materials import COAL, SANDSTONE
+from tailbeam.io.scene_file import dumps_scene, load_scene, loads_scene, tomllib
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.hertz import hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.rigid import simulate_rigid
+from tailbeam.physics.materials import COAL, SANDSTONE
 from tailbeam.scene import Scene
-from tailbeam.scene_file import dumps_scene, load_scene, loads_scene, tomllib
-from tailbeam.solvers.stream_result import (
+from tailbeam.solvers.rigid import simulate_rigid
+from tailbeam.solvers.stream.stream_result import (
     IMPACT_COLUMNS,
     PARTICLE_COLUMNS,
     STREAM_IMPACT_COLUMNS,
@@ -211,7 +211,7 @@ def test_simulate_refuses_what_it_cannot_run():
     ball = scene.balls[1]
     crowd = Scene((ball,), streams=scene.streams, duration=0.8)
     with pytest.MonkeyPatch.context() as mp:
-        import tailbeam.solvers.stream as fast
+        import tailbeam.solvers.stream.stream as fast
 
         mp.setattr(fast, "MAX_PARTICLES", 5)
         with pytest.raises(WorkLimitError, match=r"^streams\[1\].rate: .*at most 5"):
@@ -432,17 +432,17 @@ def test_simulate_bounds_the_stream_work():
 
 
 def test_the_fast_solver_plugs_in_by_existing(monkeypatch):
-    """A module tailbeam.solvers.stream with simulate_stream replaces the reference with no
+    """A module tailbeam.solvers.stream.stream with simulate_stream replaces the reference with no
     other change (the lead's one-line swap), called with the scene's particles and laws."""
     import types
 
-    from tailbeam.solvers.engine import stream_engine
+    from tailbeam.solvers.stream.engine import stream_engine
 
     calls = []
-    fake = types.ModuleType("tailbeam.solvers.stream")
+    fake = types.ModuleType("tailbeam.solvers.stream.stream")
     fake.simulate_stream = lambda *args, **kw: calls.append((args, kw)) or "fast result"
     fake.MAX_PARTICLES = 10**6
-    monkeypatch.setitem(sys.modules, "tailbeam.solvers.stream", fake)
+    monkeypatch.setitem(sys.modules, "tailbeam.solvers.stream.stream", fake)
     assert stream_engine().name == "fast stream solver"
     scene = load_scene(SMALL)
     assert tailbeam.simulate(scene, progress=False) == "fast result"

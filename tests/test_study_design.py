@@ -143,7 +143,7 @@ def test_core_imports_and_cli_work_without_the_study_extra():
         "import sys\n"
         "for m in ('dask', 'xarray', 'zarr', 'pyarrow', 'sklearn', 'pywt', 'pandas'):\n"
         "    sys.modules[m] = None  # import of any of them now fails\n"
-        "import tailbeam, tailbeam.scene_file, tailbeam.sensor, tailbeam.noise\n"
+        "import tailbeam, tailbeam.io.scene_file, tailbeam.signals.sensor, tailbeam.signals.noise\n"
         "from tailbeam.cli import main\n"
         "sys.exit(main(['sweep', 'missing.toml']))\n"
     )
@@ -174,7 +174,7 @@ def test_labels_coal_labels_the_balls_in_the_scene():
     """``labels.coal`` decides each ball's label in the case's scene (so impacts.csv's
     ``label`` and the dataset's ``class`` agree with it); the default rule writes nothing,
     so the case hashes of a default sweep do not change; an explicit ``label`` wins."""
-    from tailbeam.scene_file import loads_scene
+    from tailbeam.io.scene_file import loads_scene
     from tailbeam.study.case import run_case
 
     grid = {"balls.rock.material": ["coal", "sandstone"]}

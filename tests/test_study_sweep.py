@@ -17,7 +17,7 @@ import xarray as xr  # noqa: E402
 
 from tailbeam.cli import main  # noqa: E402
 from tailbeam.commands.simulate import solve  # noqa: E402
-from tailbeam.scene_file import loads_scene  # noqa: E402
+from tailbeam.io.scene_file import loads_scene  # noqa: E402
 
 BASE = """
 duration = 0.01

@@ -9,10 +9,10 @@ Bad input names the option (--fmax, --count, --divisions, ...), also when the ba
 costly to compute (tailbeam.plate.cost, estimated before anything is assembled).
 """
 
-from tailbeam.bodies import Plate
 from tailbeam.errors import InputError
-from tailbeam.materials import get_material
-from tailbeam.output import atomic_output_dir, check_output_dir, describe
+from tailbeam.io.output import atomic_output_dir, check_output_dir, describe
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.materials import get_material
 
 # library field names -> the options a user typed (tailbeam.cli renames InputError fields)
 CLI_FIELDS = {

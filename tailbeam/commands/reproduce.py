@@ -4,7 +4,7 @@ Runs the three built-in scenarios with the default contact settings, writes per 
 <key>/impacts.csv, <key>/impacts.json and <key>/timeseries.csv, the figures fig02-fig10 (the
 analogues of the paper's Figs. 2-10; the force figures add peak markers and a zoom on the first
 contacts), collisions_<key>.png (peak force, rebound height and restitution against collision
-number) and pulse_<key>.png (one pulse per ball; tailbeam.figures.scenario_figures), and
+number) and pulse_<key>.png (one pulse per ball; tailbeam.paper.figures.scenario_figures), and
 claims.csv / claims.md, and prints every claim with PASS/FAIL and the numbers behind it. It
 also re-checks the claims without Adams' clamp (the paper's literal eq. 1) into
 claims_clamp_off.csv / .md and prints a one-line comparison.
@@ -13,7 +13,7 @@ input, as every command).
 """
 
 from tailbeam.cachedir import announce_first_compile
-from tailbeam.output import atomic_output_dir, check_output_dir
+from tailbeam.io.output import atomic_output_dir, check_output_dir
 from tailbeam.progress import task
 from tailbeam.solvers.records import EventKind
 
@@ -54,9 +54,9 @@ def clamp_summary(results, results_off, claims_off) -> str:
 
 
 def run(args) -> int:
-    from tailbeam import claims as claims_mod
-    from tailbeam.results_io import write_claims
-    from tailbeam.scenarios import run_all
+    from tailbeam.io.results_io import write_claims
+    from tailbeam.paper import claims as claims_mod
+    from tailbeam.paper.scenarios import run_all
     from tailbeam.scene import ContactSettings
 
     check_output_dir(args.out)
@@ -81,10 +81,10 @@ def run(args) -> int:
 def _write_scenarios(tmp, results) -> None:
     """Per scenario: impacts.csv, particles.csv, impacts.json, timeseries.csv and the
     figures."""
-    from tailbeam.figures import scenario_figures
-    from tailbeam.results_io import write_result_tables, write_timeseries_csv
-    from tailbeam.scenarios import SCENARIOS
-    from tailbeam.scene_file import scene_to_dict
+    from tailbeam.io.results_io import write_result_tables, write_timeseries_csv
+    from tailbeam.io.scene_file import scene_to_dict
+    from tailbeam.paper.figures import scenario_figures
+    from tailbeam.paper.scenarios import SCENARIOS
 
     for key, result in results.items():
         scenario = SCENARIOS[key]

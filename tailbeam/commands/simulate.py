@@ -8,11 +8,11 @@ sensor_<name>.png (time and spectrum) per sensor.
 
 Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
 scene and --out are fully validated before the solver runs, and the results replace DIR
-whole (tailbeam.output), so DIR never mixes two runs.
+whole (tailbeam.io.output), so DIR never mixes two runs.
 """
 
 from tailbeam.cachedir import announce_first_compile
-from tailbeam.output import atomic_output_dir, check_output_dir, describe
+from tailbeam.io.output import atomic_output_dir, check_output_dir, describe
 from tailbeam.progress import task
 
 # Heavy modules (scipy.signal, matplotlib) are imported where they are used, so that
@@ -33,8 +33,8 @@ def solve(scene):
 
 def write_results(out_dir, scene, result) -> list:
     """Write every output file of ``result`` into ``out_dir`` (an existing directory)."""
-    from tailbeam.results_io import write_result_tables, write_timeseries_csv
-    from tailbeam.scene_file import scene_to_dict
+    from tailbeam.io.results_io import write_result_tables, write_timeseries_csv
+    from tailbeam.io.scene_file import scene_to_dict
 
     files = write_result_tables(out_dir, result, scene_to_dict(scene))
     if result.keeps_states:
@@ -49,8 +49,8 @@ def write_results(out_dir, scene, result) -> list:
 
 
 def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
-    from tailbeam.figures import sensor_figure
-    from tailbeam.results_io import write_sensor_spectra_csv, write_sensors_csv
+    from tailbeam.io.results_io import write_sensor_spectra_csv, write_sensors_csv
+    from tailbeam.paper.figures import sensor_figure
 
     meta = {
         s.name: {
@@ -80,12 +80,12 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
 
 
 def run(args) -> int:
-    from tailbeam.scene_file import load_scene
+    from tailbeam.io.scene_file import load_scene
 
     check_output_dir(args.out)
     scene = load_scene(args.scene)
     if scene.needs_stream_solver:
-        announce_first_compile("solvers")
+        announce_first_compile("stream")
     else:
         announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
     result = solve(scene)

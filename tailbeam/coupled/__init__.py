@@ -1,25 +1,4 @@
-"""Balls on a flexible (modal) plate, two-way coupled; see ``simulate_coupled``.
+"""Moved to ``tailbeam.solvers.coupled`` (issue 7); this old path was shown to users."""
 
-Public API:
-    simulate_coupled(balls, basis, laws, duration, *, sensors=(), ...) -> CoupledResult
-    simulate_scene_modal(scene) -> CoupledResult   (builds the modal basis from the scene)
-    PlateLoads, plate_response(basis, zeta, loads, points, times)   (sparse prescribed loads,
-        one-way: a stream's contacts and dead loads; tailbeam.coupled.load_response)
-"""
-
-from tailbeam.coupled.auto import choose_band, simulate_scene_modal
-from tailbeam.coupled.load_response import plate_response
-from tailbeam.coupled.loads import PlateLoads
-from tailbeam.coupled.result import CoupledResult
-from tailbeam.coupled.solver import DEFAULT_DAMPING_RATIO, modal_damping, simulate_coupled
-
-__all__ = [
-    "CoupledResult",
-    "DEFAULT_DAMPING_RATIO",
-    "PlateLoads",
-    "choose_band",
-    "modal_damping",
-    "plate_response",
-    "simulate_coupled",
-    "simulate_scene_modal",
-]
+from tailbeam.solvers.coupled import *  # noqa: F403
+from tailbeam.solvers.coupled import __all__  # noqa: F401

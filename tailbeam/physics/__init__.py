@@ -1,5 +1,4 @@
-"""Physics layer: geometry and laws of the bodies, no time integration.
-
-New modules of issue 7 (streams) live here; the refactor moves the existing physics modules
-(materials, contact_law, hertz, bodies) under this folder.
+"""Physics layer: the bodies, their materials and the laws of their contacts (no time
+integration): materials, bodies, hertz, contact_law, contact_patch, impact (the IMPACT law's
+one numba definition), incline, pair.
 """

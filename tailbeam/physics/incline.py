@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tailbeam.bodies import STANDARD_GRAVITY, Plate
 from tailbeam.errors import InputError, require_nonnegative, require_real
+from tailbeam.physics.bodies import STANDARD_GRAVITY, Plate
 
 EDGES = ("x-", "x+", "y-", "y+")
 

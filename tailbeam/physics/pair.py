@@ -12,7 +12,7 @@ one formula:
     w_t = w - (w . n) n          (tangential slip velocity: where Coulomb friction will enter)
 
 The force of the pair is F n on i and -F n on j, with F from the IMPACT law
-(``tailbeam.contact_law``). Friction and rotation add a tangential force from w_t (plus
+(``tailbeam.physics.contact_law``). Friction and rotation add a tangential force from w_t (plus
 omega x r terms in w) here, without changing the callers.
 """
 

@@ -19,8 +19,8 @@ import numpy as np
 from skfem import MeshTri
 
 from tailbeam import __version__
-from tailbeam.bodies import Plate
 from tailbeam.cachedir import cache_root
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate.closed_forms import SHEAR_COEFFICIENT
 
 CACHE_FORMAT = 1  # bump when the stored content or its meaning changes

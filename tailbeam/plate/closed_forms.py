@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tailbeam.bodies import Plate
 from tailbeam.modal import ssss_kirchhoff_frequencies
+from tailbeam.physics.bodies import Plate
 
 SHEAR_COEFFICIENT = 5.0 / 6.0  # Reissner's value for a homogeneous plate
 

@@ -11,7 +11,7 @@ import numpy as np
 from skfem import Basis, BilinearForm, ElementTriArgyris, MeshTri
 from skfem.helpers import dd, ddot, trace
 
-from tailbeam.bodies import Plate
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate.boundary import EDGES, kirchhoff_fixed_names
 
 ELEMENT_NAME = "Argyris (quintic C1 triangle)"

@@ -2,7 +2,7 @@
 (Gmsh 2.2 via meshio, which keeps the edge names) and the project's default meshes.
 
 Edges are named 'left' (x = -a/2), 'bottom' (y = -b/2), 'right' (x = +a/2), 'top' (y = +b/2);
-the plate is centred on the origin (tailbeam.bodies). Coordinates in m.
+the plate is centred on the origin (tailbeam.physics.bodies). Coordinates in m.
 """
 
 import contextlib
@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 from skfem import MeshTri
 
-from tailbeam.bodies import Plate
 from tailbeam.errors import InputError
+from tailbeam.physics.bodies import Plate
 
 EDGE_NAMES = ("left", "bottom", "right", "top")
 MAX_DIVISIONS = 200  # 80 000 triangles: beyond any band this package is meant for

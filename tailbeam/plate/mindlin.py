@@ -16,7 +16,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, BilinearForm, ElementTriP3, ElementTriP4, MeshTri
 
-from tailbeam.bodies import Plate
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate.boundary import EDGES, mindlin_fixed_fields
 from tailbeam.plate.closed_forms import SHEAR_COEFFICIENT
 

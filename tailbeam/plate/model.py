@@ -9,9 +9,9 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, MeshTri, condense
 
-from tailbeam.bodies import Plate
-from tailbeam.contact_patch import disc_rule
 from tailbeam.errors import InputError, require_nonnegative
+from tailbeam.physics.bodies import Plate
+from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.boundary import parse_boundary
 from tailbeam.plate.kirchhoff import ELEMENT_NAME as KIRCHHOFF_ELEMENT
 from tailbeam.plate.kirchhoff import assemble_kirchhoff

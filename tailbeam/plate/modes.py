@@ -12,9 +12,9 @@ import numpy as np
 from skfem import Basis, ElementTriArgyris, ElementTriP3, ElementTriP4, MeshTri
 from threadpoolctl import threadpool_limits
 
-from tailbeam.bodies import Plate
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.modal import ModalBasis
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate import cache as modal_cache
 from tailbeam.plate.boundary import EDGES, describe, parse_boundary, rigid_body_mode_count
 from tailbeam.plate.closed_forms import bending_wavenumber, ssss_kirchhoff_frequencies

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tailbeam.bodies import Plate
 from tailbeam.errors import InputError, require_positive
+from tailbeam.physics.bodies import Plate
 from tailbeam.plate.closed_forms import (
     bending_wavenumber,
     kirchhoff_model_error,

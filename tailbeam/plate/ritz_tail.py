@@ -16,7 +16,7 @@ point brings the contact quantities of the test meshes to 2-7e-6 of the full FE 
 (quasi-static residual 3.5e-5), k = 48-128 on the default Argyris 23x23 mesh. This module only
 builds them for load points known in advance (``with_ritz_tail``: the FE cross-checks, and
 the coupled solver's pre-pass over the balls' first contact points with ``plate.tail =
-"ritz"``, tailbeam.coupled.ritz_prepass).
+"ritz"``, tailbeam.solvers.coupled.ritz_prepass).
 """
 
 import numpy as np
@@ -126,7 +126,7 @@ def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> M
 
     points: (p, 2) m, where the loads act (the contact points, known in advance);
     contact_radius: m, the load is 1 N spread over a disc of this radius (0: a point load;
-    use ``tailbeam.contact_patch.load_radius`` as the solver does), one for every point or
+    use ``tailbeam.physics.contact_patch.load_radius`` as the solver does), one for every point or
     a sequence of p, one per point (balls of different sizes). The pseudo-modes have
     their true shapes (seen at sensors and other points), and the residual compliance of the
     returned basis (static minus every mode it holds) is ~0 at the points. Raises InputError

@@ -46,7 +46,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr, ndtri
 
-from tailbeam.bodies import Ball
 from tailbeam.errors import (
     InputError,
     require_nonnegative,
@@ -54,8 +53,9 @@ from tailbeam.errors import (
     require_real,
     require_vector,
 )
-from tailbeam.materials import Material, get_material
+from tailbeam.physics.bodies import Ball
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.physics.materials import Material, get_material
 
 KEYS = (
     "name", "rate", "start", "stop", "gangue_fraction", "coal_material", "gangue_material",

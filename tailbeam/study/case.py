@@ -38,8 +38,8 @@ def _band(scene) -> dict:
     """The band the scene's solver will use: a stream scene's (tailbeam.simulation), else
     the scene's plate.fmax when set (then the contact pulses choose_band also estimates,
     ~5 ms per case, are not needed here), else choose_band's."""
-    from tailbeam.coupled.auto import choose_band
     from tailbeam.simulation import stream_band
+    from tailbeam.solvers.coupled.auto import choose_band
 
     if scene.needs_stream_solver:
         return stream_band(scene)
@@ -51,9 +51,9 @@ def _band(scene) -> dict:
 def warm_basis(scene_toml: str) -> str:
     """Compute (or load) the modal basis of the scene into the on-disk cache; returns the
     basis description. Runs once per basis_signature before the sweep's cases."""
-    from tailbeam.coupled.auto import build_basis
-    from tailbeam.scene_file import loads_scene
+    from tailbeam.io.scene_file import loads_scene
     from tailbeam.simulation import stream_band
+    from tailbeam.solvers.coupled.auto import build_basis
 
     try:
         scene = loads_scene(scene_toml)
@@ -101,7 +101,7 @@ def run_case(scene_toml: str, *_after) -> dict:
     ``_after`` are ignored (Dask dependencies, e.g. the warmed basis; callers before the
     labels moved into the scene passed the coal materials here)."""
     from tailbeam.commands.simulate import solve
-    from tailbeam.scene_file import loads_scene
+    from tailbeam.io.scene_file import loads_scene
 
     t0 = time.perf_counter()
     c0 = time.process_time()

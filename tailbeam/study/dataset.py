@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam import __version__
-from tailbeam.scene_file import loads_scene
+from tailbeam.io.scene_file import loads_scene
 
 LABEL_COLUMNS = (
     "label",

@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam.errors import InputError, require_positive
-from tailbeam.scene_file import _check_keys, dumps_scene, parse_scene
+from tailbeam.io.scene_file import _check_keys, dumps_scene, parse_scene
 from tailbeam.study.case import basis_signature
 
 if sys.version_info >= (3, 11):

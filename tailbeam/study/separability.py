@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from tailbeam.results_io import write_csv
+from tailbeam.io.results_io import write_csv
 from tailbeam.study.learn import learn
 from tailbeam.study.windows import feature_table
 

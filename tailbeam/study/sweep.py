@@ -19,8 +19,8 @@ import time
 import uuid
 
 from tailbeam.errors import InputError
+from tailbeam.io.scene_file import loads_scene
 from tailbeam.progress import note, task
-from tailbeam.scene_file import loads_scene
 from tailbeam.study.case import run_case, warm_basis
 from tailbeam.study.dataset import DatasetStore
 from tailbeam.study.design import expand

@@ -43,8 +43,8 @@ def case_table(ds):
 
 def add_noise(acc, fs: float, rms: float, seeds, sensors) -> np.ndarray:
     """``acc`` (case, sensor, time) plus white noise of RMS ``rms`` (m/s^2), the model of
-    ``[[sensors]] noise`` (tailbeam.noise) drawn from each case's seed and sensor name."""
-    from tailbeam.noise import NoiseSpec, noise
+    ``[[sensors]] noise`` (tailbeam.signals.noise) drawn from each case's seed and sensor name."""
+    from tailbeam.signals.noise import NoiseSpec, noise
 
     out = np.array(acc, dtype=float)
     for i, seed in enumerate(seeds):

@@ -1,0 +1,3 @@
+"""Signals: the accelerometer chain a sensor on the plate measures through (sensor),
+measurement noise (noise) and the sensor figures.
+"""

@@ -1,0 +1,305 @@
+"""Model only what the scene needs: the modal band, its cost, then the run, from a Scene.
+
+Band. Two outputs need modes: the sensor signals and the contact forces.
+- A sensor cannot see above its bandwidth: the band reaches the largest sensor bandwidth.
+- A contact is softened by the modes left out only through their compliance, which the
+  residual flexibility adds quasi-statically; what it misses is their dynamic excess. The
+  contact's force pulse F(t) is computed once per ball on a rigid plate (the IMPACT law with
+  its damping, at the hardest impact speed the ball can reach; scipy, ~10 ms): its RMS
+  angular frequency Omega = sqrt(int F'^2 / int F^2) (pi/T for a half-sine; the damping
+  ramp over the penetration d sharpens small balls' pulses up to 1.7x), and its secant
+  compliance C_c = delta / F at the force peak. A mode of frequency f responds with a dynamic
+  excess 1/(u^2 - 1), u = 2 pi f / Omega, over its static F/omega^2, so treating every mode
+  above fc quasi-statically misses C_res(fc) g(u_c) of compliance,
+  g(u) = (u/2) ln((u+1)/(u-1)) - 1 ~ 1/(3 u^2) (the 1/f^2 weight of the modal sum over a
+  plate's near-constant modal density). C_res(fc), the static compliance of the modes above
+  fc at a point, is the infinite thin plate's 1 / (8 pi^2 fc sqrt(rho h D)) (within 5 % of the
+  SSSS closed form, tests/test_band.py). Energy balance at the peak (E = F delta/(e+1) +
+  C F^2/2) turns a compliance error dC into a peak-force error (e/2) dC / C_c:
+      force error(fc) ~ BAND_SAFETY (e/2) C_res(fc) g(u_c) / C_c
+  The model is crude (the onset of a damped pulse excites high modes more than its RMS
+  frequency says), so BAND_SAFETY is calibrated: on exact SSSS modes (independent of the FE
+  model) measured / estimate was 0.04-0.85 for 5-40 mm coal and sandstone at 0.5-6 m/s with
+  and without contact damping, bands 1/T to 4/T (tests/test_band.py checks four of them); on
+  the FE Mindlin plate of the 30-ball scene see benchmarks/bench_band.py and NOTES-band.md.
+  The contacts need the smallest fc >= 1/T with force error <= ``BAND_ACCURACY``. Without
+  residual flexibility the modes above fc are missing: error ~ BAND_SAFETY (e/2) C_res / C_c.
+fmax = max(sensor bandwidth, contact band), rounded up to a multiple of BAND_GRID_HZ so that
+small edits of a scene reuse the cached basis. The user's [plate] fmax overrides.
+
+The sensors (result.info["band"]["sensor_note"]): with fmax at the bandwidth every mode a
+sensor can see is kept; the modes above fmax reach a sensor only through their quasi-static
+response, which the mode-acceleration correction adds at each sensor when residual
+flexibility is on (CoupledResult.plate_sample, docs/fe-convergence.md).
+
+Cost. Before anything is assembled the basis's DOFs, modes, memory and time are estimated
+(tailbeam.plate.cost) and a band over the limits is refused naming ``plate.fmax``.
+Theory and mesh: tailbeam.plate.compute_modes(theory="auto") picks them from the band.
+"""
+
+import math
+
+import numpy as np
+
+from tailbeam.errors import InputError
+from tailbeam.physics.bodies import STANDARD_GRAVITY
+from tailbeam.physics.contact_law import impact_force, impact_force_scalar
+from tailbeam.physics.hertz import hertz_contact_duration
+from tailbeam.progress import note
+from tailbeam.scene import ModalPlateSettings, Scene
+from tailbeam.signals.sensor import resolve
+from tailbeam.solvers.coupled.ritz_prepass import apply_tail, check_tail_scene, describe_tail
+from tailbeam.solvers.coupled.solver import simulate_coupled
+
+BAND_ACCURACY = 5e-3  # target peak-force error from the band: half the outputs' 1 %
+BAND_SAFETY = 20.0  # on the force-error estimate (calibrated, see the module docstring)
+BAND_GRID_HZ = 500.0  # the automatic fmax is rounded up to a multiple of this (cache reuse)
+PULSE_SAMPLES = 1000  # samples of the rigid-plate force pulse for its RMS frequency
+MIN_CONTACT_BAND_FACTOR = 1.0  # fc >= 1 / T: modes below 1/T respond dynamically
+SCENE_FIELDS = {"fmax_hz": "plate.fmax", "divisions": "plate.mesh_divisions"}
+
+
+def contact_durations(scene: Scene, gravity: float = STANDARD_GRAVITY) -> dict:
+    """Hertz contact duration (s) of each ball's hardest impact: the speed after falling from
+    its start, sqrt(vz^2 + 2 g gap); elastic rebounds never exceed it."""
+    return {name: c["duration_s"] for name, c in _contacts(scene, gravity).items()}
+
+
+def _contacts(scene: Scene, gravity: float = STANDARD_GRAVITY) -> dict:
+    """Per ball's hardest impact (the speed after falling from its start, sqrt(vz^2 + 2 g
+    gap); rebounds never exceed it): impact_pulse of it, plus the speed (m/s)."""
+    out = {}
+    for ball, law in zip(scene.balls, scene.laws(), strict=True):
+        speed = max(math.sqrt(ball.velocity[2] ** 2 + 2 * gravity * max(ball.gap, 0.0)), 1e-3)
+        out[ball.name] = {"speed_m_s": speed, **impact_pulse(ball.mass, speed, law)}
+    return out
+
+
+def impact_pulse(mass: float, speed: float, law) -> dict:
+    """Force pulse of a ball of ``mass`` (kg) striking a rigid flat at ``speed`` (m/s) under
+    the IMPACT ``law``, without gravity: duration_s (s), compliance_m_n = penetration / force
+    at the force peak (m/N), pulse_omega = sqrt(int F'^2 dt / int F^2 dt) (rad/s), exponent."""
+    from scipy.integrate import solve_ivp
+
+    t_hertz = hertz_contact_duration(mass, speed, law.stiffness, law.exponent)
+
+    def force(d, dd):
+        args = (law.stiffness, law.exponent, law.damping, law.penetration, law.clamp)
+        return impact_force_scalar(d, dd, *args)
+
+    def leave(t, y):  # penetration back to zero, or (clamped law) the force back to zero
+        return 1.0 if t < 1e-3 * t_hertz else min(y[0], force(y[0], y[1]) + 1e-300)
+
+    leave.terminal, leave.direction = True, -1
+    sol = solve_ivp(
+        lambda t, y: (y[1], -force(y[0], y[1]) / mass),
+        (0.0, 10.0 * t_hertz),
+        (0.0, speed),
+        rtol=1e-7,
+        atol=1e-10 * speed * t_hertz,
+        max_step=t_hertz / 50.0,
+        dense_output=True,
+        events=leave,
+    )
+    t = np.linspace(0.0, sol.t[-1], PULSE_SAMPLES)
+    d, dd = sol.sol(t)
+    f = impact_force(d, dd, law)
+    peak = int(np.argmax(f))
+    slope = np.gradient(f, t)
+    return {
+        "duration_s": float(sol.t[-1]),
+        "compliance_m_n": float(d[peak] / f[peak]),
+        "pulse_omega": float(np.sqrt(np.trapezoid(slope**2, t) / np.trapezoid(f**2, t))),
+        "exponent": law.exponent,
+    }
+
+
+def residual_compliance_estimate(plate, f_cut_hz: float) -> float:
+    """Static compliance (m/N) of the modes above ``f_cut_hz`` at a point: the infinite thin
+    plate's 1 / (8 pi^2 f sqrt(rho h D)) (constant modal density A/2 sqrt(rho h/D), mean
+    squared unit-mass shape 1/(rho h A)), without the safety factor."""
+    return 1.0 / (
+        8.0 * math.pi**2 * f_cut_hz * math.sqrt(plate.mass_per_area * plate.bending_stiffness)
+    )
+
+
+def _dynamic_fraction(u):
+    """Compliance the quasi-static treatment misses, as a fraction of C_res(fc), u = fc / f_p:
+    the modal sum's 1/f^2 weight times each mode's dynamic excess 1/(u^2 - 1) above fc,
+    integrated: (u/2) ln((u+1)/(u-1)) - 1 (~ 1/(3 u^2) for large u)."""
+    return 0.5 * u * math.log((u + 1.0) / (u - 1.0)) - 1.0
+
+
+def force_error_estimate(plate, f_cut_hz, contact: dict, residual=True) -> float:
+    """Estimated relative peak-force error of ``contact`` (an entry of _contacts) when the
+    band stops at ``f_cut_hz`` (module docstring)."""
+    scale = BAND_SAFETY * 0.5 * contact["exponent"] / contact["compliance_m_n"]
+    c_res = residual_compliance_estimate(plate, f_cut_hz)
+    if not residual:
+        return scale * c_res
+    u = 2.0 * math.pi * f_cut_hz / contact["pulse_omega"]
+    if u <= 1.0:
+        return math.inf  # the band stops below the pulse's own frequency
+    return scale * c_res * _dynamic_fraction(u)
+
+
+def contact_band(plate, contact: dict, accuracy=BAND_ACCURACY, residual=True) -> float:
+    """Smallest band (Hz), at least MIN_CONTACT_BAND_FACTOR / T, whose force_error_estimate
+    is ``accuracy`` (the estimate falls monotonically with the band)."""
+    from scipy.optimize import brentq
+
+    def excess(f):
+        return force_error_estimate(plate, f, contact, residual) - accuracy
+
+    lo = MIN_CONTACT_BAND_FACTOR / contact["duration_s"]
+    if excess(lo) <= 0.0:
+        return lo
+    hi = 2.0 * lo
+    while excess(hi) > 0.0:
+        hi *= 2.0
+    return brentq(excess, lo, hi, rtol=1e-6)
+
+
+def choose_band(scene: Scene, settings: ModalPlateSettings | None = None) -> dict:
+    """The modal band for ``scene``: fmax (Hz) with the reasons and the estimated errors."""
+    settings = settings or scene.modal or ModalPlateSettings()
+    residual = settings.residual_flexibility
+    contacts = _contacts(scene, scene.gravity)
+    needs = {name: contact_band(scene.plate, c, residual=residual) for name, c in contacts.items()}
+    hardest = max(needs, key=needs.get)
+    f_contact = needs[hardest]
+    f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
+    # on a grid, so that small edits of a scene (a ball's height or speed) reuse the cached basis
+    chosen = BAND_GRID_HZ * math.ceil(max(f_contact, f_sensor) / BAND_GRID_HZ - 1e-9)
+    fmax = settings.fmax_hz if settings.fmax_hz is not None else chosen
+    t_min = min(c["duration_s"] for c in contacts.values())
+    errors = {
+        name: force_error_estimate(scene.plate, fmax, c, residual=residual)
+        for name, c in contacts.items()
+    }
+    return {
+        "fmax_hz": float(fmax),
+        "user_fmax": settings.fmax_hz is not None,
+        "reason": _reason(settings, f_contact, f_sensor, hardest),
+        "accuracy": BAND_ACCURACY,
+        "contact_duration_min_s": t_min,
+        "fmax_contact_hz": float(f_contact),
+        "fmax_sensors_hz": float(f_sensor),
+        "hardest_contact": hardest,
+        # estimated relative peak-force error from the band, worst ball
+        "truncation_force_error": float(max(errors.values())),
+        # kept from the earlier rule (a contract of impacts.json): the half-sine force-spectrum
+        # level 1/((2 fmax T_min)^2 - 1) of the shortest contact at fmax
+        "truncation_force_level": _spectrum_level(fmax, t_min),
+        "sensor_band_covered": bool(fmax >= f_sensor),
+        "sensor_note": (
+            "modes above fmax reach the sensors quasi-statically (mode-acceleration "
+            "correction, with residual flexibility on)"
+        ),
+    }
+
+
+def _spectrum_level(fmax, t_min) -> float:
+    x = 2.0 * fmax * t_min
+    return float(1.0 / (x * x - 1.0)) if x > 1.0 else 1.0
+
+
+def _reason(settings, f_contact, f_sensor, hardest) -> str:
+    if settings.fmax_hz is not None:
+        return "plate.fmax set in the scene"
+    if f_sensor >= f_contact:
+        return f"sensor bandwidth {f_sensor / 1e3:.1f} kHz (contacts need {f_contact / 1e3:.1f})"
+    return (
+        f"contact of {hardest}: {f_contact / 1e3:.1f} kHz for a peak-force error "
+        f"<= {BAND_ACCURACY:g} (sensors need {f_sensor / 1e3:.1f})"
+    )
+
+
+def build_basis(scene: Scene, band: dict | None = None, *, use_cache: bool = True):
+    """The modal basis of the scene's plate (tailbeam.plate.compute_modes) for the band;
+    a band too costly to compute is refused naming plate.fmax."""
+    settings = scene.modal or ModalPlateSettings()
+    band = band or choose_band(scene, settings)
+    from tailbeam.plate import compute_modes
+
+    try:
+        return compute_modes(
+            scene.plate,
+            settings.boundary,
+            theory=settings.theory,
+            fmax_hz=band["fmax_hz"],
+            divisions=settings.mesh_divisions,
+            use_cache=use_cache,
+        )
+    except InputError as err:
+        raise err.renamed(SCENE_FIELDS) from None
+
+
+def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **options):
+    """Run a scene on the modal plate: choose the band, build (or take) the basis, simulate.
+
+    ``options`` go to simulate_coupled (e.g. steps_per_contact). The band and the basis's
+    description are in result.info["band"] and result.info["basis"]; describe_choices(info)
+    says it in one line."""
+    if not isinstance(scene, Scene):
+        raise InputError("scene", "must be a tailbeam.scene.Scene")
+    settings = scene.modal or ModalPlateSettings()
+    check_tail_scene(scene)  # before the basis is built
+    band = choose_band(scene, settings)
+    if basis is None:
+        basis = build_basis(scene, band, use_cache=use_cache)
+    basis, tail = apply_tail(scene, basis, settings)
+    choices = {**_choices(band, basis), "tail": tail}
+    note(describe_choices(choices))  # before the run, so a long run says what it runs
+    result = simulate_coupled(
+        scene.balls,
+        basis,
+        scene.laws(),
+        scene.duration,
+        sensors=scene.sensors,
+        damping_ratio=settings.damping_ratio,
+        rayleigh=settings.rayleigh,
+        residual_flexibility=settings.residual_flexibility,
+        coupling=settings.coupling,
+        gravity=scene.gravity,
+        **options,
+    )
+    result.info.update(choices)
+    return result
+
+
+def _choices(band: dict, basis) -> dict:
+    """The automatic choices as recorded in result.info (band, basis) and impacts.json."""
+    described = {
+        "theory": basis.theory,
+        "boundary": basis.boundary,
+        "n_modes": basis.n_modes,
+        "top_frequency_hz": float(basis.frequencies_hz[-1]),
+        **{k: v for k, v in basis.info.items() if isinstance(v, (str, int, float, bool))},
+    }
+    cost = basis.info.get("cost_estimate")
+    if isinstance(cost, dict):
+        described["cost_estimate"] = cost
+    return {"band": band, "basis": described}
+
+
+def describe_choices(info: dict) -> str:
+    """One line of what was chosen automatically, from a modal result's ``info``."""
+    band, basis = info.get("band", {}), info.get("basis", {})
+    if not band:
+        return "rigid plate: no modal band"
+    parts = [f"band 0-{band['fmax_hz'] / 1e3:.1f} kHz ({band['reason']})"]
+    if basis:
+        mesh = f", {basis['divisions']} divisions" if basis.get("divisions") else ""
+        parts.append(
+            f"{basis['theory']}{mesh}, {basis['n_modes']} modes"
+            + (f", {basis['n_dofs']} DOFs" if "n_dofs" in basis else "")
+            + (f", basis cache {basis['cache']}" if "cache" in basis else "")
+        )
+    if describe_tail(info.get("tail", {})):
+        parts.append(describe_tail(info["tail"]))
+    without = " without the Ritz tail" if info.get("tail", {}).get("model") == "ritz" else ""
+    parts.append(f"est. peak-force truncation error{without} {band['truncation_force_error']:.1e}")
+    if not band["sensor_band_covered"]:
+        parts.append("band below a sensor's bandwidth")
+    return "; ".join(parts)

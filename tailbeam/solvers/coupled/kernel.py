@@ -1,0 +1,355 @@
+"""The compiled stepping kernel of the two-way coupled ball / modal-plate model.
+
+State: modal coordinates q, q' (n,), ball heights z and vertical speeds vz (nb,), the contact
+forces F (nb,) at the current time and each ball's mode (flight, contact, clamped, rest).
+
+One step is ``tailbeam.solvers.coupled.step.solve_step`` (implicit contact forces, exact modes).
+
+Events (contact start / end, STEP kink delta = d, clamp on / off) are located on the step
+function itself (Illinois root finding on tau): the kernel stops at the first event so the
+driver can record it and update the modes of the balls. Contact starts can never be missed:
+a step only goes on when the gap of every flying ball is certified positive on the whole step
+by two bounds (|gap'| <= L, and gap'' >= -(g + A) with A a bound on the plate acceleration
+from the modal energies), else the step is bisected. In free flight the step is the certified
+horizon itself, so flights take a few dozen exact jumps, not contact-size steps.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from tailbeam.solvers.coupled.step import CLAMPED, CONTACT, FLIGHT, solve_step
+
+EV_NONE, EV_START, EV_END, EV_DEEP, EV_SHALLOW, EV_CLAMP_ON, EV_CLAMP_OFF = range(7)
+ST_STOP, ST_EVENT, ST_FULL, ST_FAIL, ST_STEPS = range(5)
+
+
+@njit(cache=True)
+def _bounds(ctx, st, f0m, f1m, tau, g):
+    """Per-ball bounds over a step of tau: L >= |gap'| and A >= |plate acceleration|."""
+    omega, zeta, phi, _c, _m, _r, _k, _e, _cc, _d, _cl = ctx
+    q, qd, _z, vz, _F, _mode, _deep, _cur, _hist = st
+    nb, n = phi.shape
+    amp = np.empty(n)
+    acc = np.empty(n)
+    for i in range(n):
+        w2 = omega[i] ** 2
+        df = abs(f1m[i] - f0m[i])
+        y = q[i] - f0m[i] / w2  # about the static position under the starting force
+        a = math.sqrt(qd[i] ** 2 + w2 * y * y) + df * tau
+        amp[i] = a
+        acc[i] = df + omega[i] * (1.0 + 2.0 * zeta[i]) * a
+    L = np.empty(nb)
+    A = np.empty(nb)
+    for b in range(nb):
+        L[b] = abs(vz[b]) + g * tau + np.dot(np.abs(phi[b]), amp)
+        A[b] = np.dot(np.abs(phi[b]), acc)
+    return L, A
+
+
+@njit(cache=True)
+def _event_value(kind, b, aux, d):
+    if kind == EV_START:
+        return -aux[0, b]  # gap
+    if kind == EV_END:
+        return aux[0, b]
+    if kind == EV_DEEP or kind == EV_SHALLOW:
+        return aux[0, b] - d[b]
+    return aux[2, b]
+
+
+def _alloc(nb, n):
+    return (
+        np.empty(n),
+        np.empty(n),
+        np.empty(nb),
+        np.empty(nb),
+        np.empty(nb),
+        np.empty((4, nb)),
+        np.full((8, n + 1), -1.0),  # coefficient table + its tau
+        np.empty(n),
+        np.empty(n),
+    )
+
+
+_alloc = njit(cache=True)(_alloc)
+
+
+@njit(cache=True)
+def _copy_out(src, dst):
+    dst[0][:] = src[0]
+    dst[1][:] = src[1]
+    dst[2][:] = src[2]
+    dst[3][:] = src[3]
+    dst[4][:] = src[4]
+    dst[5][:, :] = src[5]
+    dst[6][:, :] = src[6]
+    dst[7][:] = src[7]
+    dst[8][:] = src[8]
+
+
+@njit(cache=True)
+def _locate(kind, b, lo, flo, hi, fhi, ctx, st, out, g, d, guess):
+    """Shrink [lo, hi] (f(lo) > 0 > f(hi) up to sign) around the event; returns hi.
+
+    ``out`` holds the solution at the returned hi (the side where the event has happened)."""
+    F1 = out[4]
+    sgn = 1.0 if flo > 0.0 else -1.0
+    flo *= sgn
+    fhi *= sgn
+    side = 0
+    for _it in range(200):
+        if hi - lo <= 1e-15 + 1e-13 * hi:
+            break
+        tm = (lo * fhi - hi * flo) / (fhi - flo)
+        if not (lo < tm < hi):
+            tm = 0.5 * (lo + hi)
+        F1[:] = guess
+        if not solve_step(tm, ctx, st, out, g):
+            return -1.0
+        fm = sgn * _event_value(kind, b, out[5], d)
+        if fm >= 0.0:  # not yet happened (a zero stays on this side: hi is strictly past)
+            lo, flo = tm, fm
+            if side == 1:
+                fhi *= 0.5
+            side = 1
+        else:
+            hi, fhi = tm, fm
+            if side == -1:
+                flo *= 0.5
+            side = -1
+    F1[:] = guess
+    if not solve_step(hi, ctx, st, out, g):
+        return -1.0
+    return hi
+
+
+@njit(cache=True)
+def _certify(b, tau, ctx, st, out, g, L, A, gap0, rate0, guess):
+    """Earliest (lo, hi, f(lo), f(hi)) bracket of a contact start of flying ball b in (0, tau],
+    or lo = -1 if the gap is certified positive on the whole step (bisection with bounds)."""
+    stack = np.empty((64, 4))
+    stack[0, 0] = 0.0
+    stack[0, 1] = tau
+    stack[0, 2] = gap0
+    stack[0, 3] = rate0
+    top = 1
+    count = 0
+    while top > 0 and count < 200:
+        count += 1
+        top -= 1
+        a, bb, ga, ra = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
+        out[4][:] = guess
+        if not solve_step(bb, ctx, st, out, g):
+            return -2.0, 0.0, 0.0, 0.0
+        gb = -out[5][0, b]
+        if gb <= 0.0:
+            return a, bb, ga, gb
+        span = bb - a
+        if ga + gb >= L[b] * span:
+            continue
+        if ga >= 0.0 and ga + ra * span - 0.5 * (g + A[b]) * span * span > 0.0:
+            continue
+        if top + 2 >= 64 or span < 1e-15:
+            continue  # a graze below any resolvable depth: no contact
+        mid = 0.5 * (a + bb)
+        out[4][:] = guess
+        if not solve_step(mid, ctx, st, out, g):
+            return -2.0, 0.0, 0.0, 0.0
+        gm = -out[5][0, b]
+        rm = out[5][3, b]
+        # push the later half first so the earlier half is examined first
+        stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = mid, bb, gm, rm
+        top += 1
+        stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = a, mid, ga, ra
+        top += 1
+    return -1.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True)
+def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
+    """Step from t until t_stop, the first event, a full buffer or max_steps.
+
+    Returns (status, t, nbuf, steps). bufs = (t, z, vz, F, delta) node buffers; evout[0:2] =
+    (kind, ball) of the event that stopped the run.
+    """
+    _om, _ze, phi, _cr, mass, _ra, _k, _e, _c, d, clampf = ctx
+    q, qd, z, vz, F, mode, deep, cur, hist = st
+    bt, bz, bvz, bF, bd = bufs
+    nb, n = phi.shape
+    out = _alloc(nb, n)
+    out2 = _alloc(nb, n)
+    out_best = _alloc(nb, n)
+    q1, qd1, z1, vz1, F1, aux, _coef, f0m, f1m = out
+    guess = np.empty(nb)
+    fm = np.empty(n)
+    evout[0] = EV_NONE
+    evout[1] = -1
+    # events that happened at the same instant as the one that ended the previous run
+    for b in range(nb):
+        kd = EV_NONE
+        if mode[b] == FLIGHT and cur[0, b] >= 0.0:
+            kd = EV_START
+            mode[b] = CONTACT
+            deep[b] = cur[0, b] > d[b]
+        elif (mode[b] == CONTACT or mode[b] == CLAMPED) and cur[0, b] < 0.0:
+            kd = EV_END
+            mode[b] = FLIGHT
+            F[b] = 0.0
+            deep[b] = False
+        elif (mode[b] == CONTACT or mode[b] == CLAMPED) and (cur[0, b] > d[b]) != deep[b]:
+            kd = EV_SHALLOW if deep[b] else EV_DEEP
+            deep[b] = not deep[b]
+        elif clampf[b] and mode[b] == CONTACT and cur[2, b] < 0.0:
+            kd = EV_CLAMP_ON
+            mode[b] = CLAMPED
+        elif clampf[b] and mode[b] == CLAMPED and cur[2, b] > 0.0:
+            kd = EV_CLAMP_OFF
+            mode[b] = CONTACT
+        if kd != EV_NONE:
+            evout[0] = kd
+            evout[1] = b
+            return ST_EVENT, t, nbuf, 0
+    steps = 0
+    while t < t_stop:
+        if nbuf >= bt.shape[0]:
+            return ST_FULL, t, nbuf, steps
+        if steps >= max_steps:
+            return ST_STEPS, t, nbuf, steps
+        steps += 1
+        in_contact = False
+        for b in range(nb):
+            if mode[b] == CONTACT or mode[b] == CLAMPED:
+                in_contact = True
+        remaining = t_stop - t
+        if in_contact:
+            tau = remaining
+            for b in range(nb):
+                if mode[b] == CONTACT or mode[b] == CLAMPED:
+                    tau = min(tau, h[b])
+        else:
+            fm[:] = 0.0
+            for b in range(nb):
+                if F[b] != 0.0:
+                    fm -= phi[b] * F[b]
+            L, A = _bounds(ctx, st, fm, fm, 0.0, g)
+            tau = remaining
+            for b in range(nb):
+                if mode[b] != FLIGHT:
+                    continue
+                gap = -cur[0, b]
+                rate = cur[3, b]
+                V = L[b]
+                t1 = 2.0 * gap / (V + math.sqrt(V * V + 4.0 * g * gap))
+                at = g + A[b]
+                root = math.sqrt(max(rate * rate + 2.0 * at * gap, 0.0))
+                if rate < 0.0:
+                    t2 = 2.0 * gap / (root - rate)  # stable form while approaching
+                elif at > 0.0:
+                    t2 = (rate + root) / at
+                else:
+                    t2 = remaining
+                tau = min(tau, max(max(t1, t2) * (1.0 - 1e-9), h[b]))
+        tau = min(tau, remaining)
+        for b in range(nb):
+            guess[b] = F[b] + hist[0, b] * tau
+            F1[b] = guess[b]
+        if not solve_step(tau, ctx, st, out, g):
+            return ST_FAIL, t, nbuf, steps
+        # --- events on this step: keep the earliest
+        best = tau
+        kind_best = EV_NONE
+        b_best = -1
+        L, A = _bounds(ctx, st, f0m, f1m, tau, g)
+        for b in range(nb):
+            kinds = np.zeros(4, dtype=np.int64)
+            nk = 0
+            if mode[b] == CONTACT or mode[b] == CLAMPED:
+                if aux[0, b] < 0.0:
+                    kinds[nk] = EV_END
+                    nk += 1
+                if (aux[0, b] > d[b]) != deep[b]:
+                    kinds[nk] = EV_SHALLOW if deep[b] else EV_DEEP
+                    nk += 1
+                if clampf[b] and mode[b] == CONTACT and aux[2, b] < 0.0:
+                    kinds[nk] = EV_CLAMP_ON
+                    nk += 1
+                if clampf[b] and mode[b] == CLAMPED and aux[2, b] > 0.0:
+                    kinds[nk] = EV_CLAMP_OFF
+                    nk += 1
+                for kk in range(nk):
+                    kd = kinds[kk]
+                    f_lo = _event_value(kd, b, cur, d)
+                    f_hi = _event_value(kd, b, aux, d)
+                    if f_lo == 0.0:
+                        f_lo = -f_hi * 1e-30
+                    hit = _locate(kd, b, 0.0, f_lo, tau, f_hi, ctx, st, out2, g, d, guess)
+                    if hit < 0.0:
+                        return ST_FAIL, t, nbuf, steps
+                    if hit < best or kind_best == EV_NONE:
+                        best, kind_best, b_best = hit, kd, b
+                        _copy_out(out2, out_best)
+            elif mode[b] == FLIGHT:
+                lo, hi, flo, fhi = _certify(
+                    b, tau, ctx, st, out2, g, L, A, -cur[0, b], cur[3, b], guess
+                )
+                if lo == -2.0:
+                    return ST_FAIL, t, nbuf, steps
+                if lo >= 0.0:
+                    if flo == 0.0:
+                        flo = 1e-300
+                    hit = _locate(EV_START, b, lo, flo, hi, fhi, ctx, st, out2, g, d, guess)
+                    if hit < 0.0:
+                        return ST_FAIL, t, nbuf, steps
+                    if hit < best or kind_best == EV_NONE:
+                        best, kind_best, b_best = hit, EV_START, b
+                        _copy_out(out2, out_best)
+        if kind_best != EV_NONE:
+            # the solution at the located time, exactly as the root finder checked its sign
+            tau = best
+            _copy_out(out_best, out)
+        # --- accept
+        for b in range(nb):
+            if mode[b] == CONTACT or mode[b] == CLAMPED:
+                hist[0, b] = (F1[b] - F[b]) / tau
+                hist[1, b] = tau
+            else:
+                hist[0, b] = 0.0
+                hist[1, b] = 0.0
+        q[:] = q1
+        qd[:] = qd1
+        z[:] = z1
+        vz[:] = vz1
+        F[:] = F1
+        cur[:, :] = aux
+        t = t + tau
+        bt[nbuf] = t
+        bz[nbuf, :] = z
+        bvz[nbuf, :] = vz
+        bF[nbuf, :] = F
+        bd[nbuf, :] = aux[0]
+        nbuf += 1
+        if kind_best != EV_NONE:
+            b = b_best
+            if kind_best == EV_START:
+                mode[b] = CONTACT
+                deep[b] = aux[0, b] > d[b]
+            elif kind_best == EV_END:
+                mode[b] = FLIGHT
+                F[b] = 0.0
+                deep[b] = False
+            elif kind_best == EV_DEEP or kind_best == EV_SHALLOW:
+                deep[b] = aux[0, b] > d[b]
+            elif kind_best == EV_CLAMP_ON:
+                mode[b] = CLAMPED
+            else:
+                mode[b] = CONTACT
+            if kind_best != EV_DEEP and kind_best != EV_SHALLOW:
+                # dF/dt jumps here (the STEP kink keeps it continuous): restart the BDF2 history
+                hist[0, b] = 0.0
+                hist[1, b] = 0.0
+            evout[0] = kind_best
+            evout[1] = b
+            return ST_EVENT, t, nbuf, steps
+    return ST_STOP, t, nbuf, steps

@@ -1,0 +1,72 @@
+"""Bookkeeping of the coupled driver: residual compliance at contact points (cached) and the
+Impact record of a finished contact."""
+
+import math
+import weakref
+
+import numpy as np
+
+from tailbeam.modal import ModalBasis
+from tailbeam.solvers.rigid.result import Impact
+
+_COMPLIANCE_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+class Compliance:
+    """Residual compliance at contact points, cached per basis (the static solve is slow).
+
+    radius: the load model's disc radius (tailbeam.physics.contact_patch.load_radius, already on its
+    5 % logarithmic grid; 0 for a point load)."""
+
+    def __init__(self, basis: ModalBasis, enabled: bool):
+        self.basis = basis
+        self.enabled = enabled
+        self.cache = _COMPLIANCE_CACHE.setdefault(basis, {})
+
+    def __call__(self, x, y, radius):
+        if not self.enabled:
+            return 0.0
+        key = (round(x, 9), round(y, 9), radius)
+        if key not in self.cache:
+            self.cache[key] = float(self.basis.residual_compliance([[x, y]], radius)[0])
+        return self.cache[key]
+
+
+def close_contact(info, b, ball, t_end, v_out, bufs, nbuf, radius, gravity, *, at_rest, z=math.nan):
+    """The Impact record of a finished contact (peak refined by a parabola through 3 nodes)."""
+    bt, _bz, _bvz, bF, bd = bufs
+    i0 = info["node"]
+    ts, fs, ds = bt[i0:nbuf], bF[i0:nbuf, b], bd[i0:nbuf, b]
+    j = int(np.argmax(fs))
+    peak, t_peak = float(fs[j]), float(ts[j])
+    if 0 < j < len(fs) - 1:
+        t0, t1, t2 = ts[j - 1 : j + 2]
+        f0, f1, f2 = fs[j - 1 : j + 2]
+        # vertex of the parabola through the three nodes (non-uniform spacing)
+        d01, d12 = (f1 - f0) / (t1 - t0), (f2 - f1) / (t2 - t1)
+        curv = (d12 - d01) / (t2 - t0)
+        if curv < 0:
+            tv = 0.5 * (t0 + t1) - d01 / (2 * curv)
+            if t0 <= tv <= t2:
+                fv = f1 + d01 * (tv - t1) + curv * (tv - t0) * (tv - t1)
+                if fv >= peak:
+                    peak, t_peak = float(fv), float(tv)
+    v_in = float(info["v_in"])
+    v_out = float(v_out)
+    apex = math.nan
+    if not at_rest and math.isfinite(v_out) and v_out > 0:
+        apex = float(z) - radius + (v_out**2 / (2 * gravity) if gravity > 0 else math.inf)
+    return Impact(
+        ball=ball.name,
+        index=info["index"],
+        t_start=float(info["t_start"]),
+        t_end=float(t_end),
+        v_in=v_in,
+        v_out=0.0 if at_rest else v_out,
+        restitution=(0.0 if at_rest else v_out) / v_in if v_in > 0 else math.nan,
+        peak_force=peak,
+        t_peak=t_peak,
+        max_penetration=float(np.max(ds)) if len(ds) else math.nan,
+        next_apex_height=apex,
+        ends_at_rest=bool(at_rest),
+    )

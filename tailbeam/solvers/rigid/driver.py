@@ -1,0 +1,189 @@
+"""Event-driven bookkeeping of flights and contacts, shared by the fast and reference solvers.
+
+A global event queue (a heap keyed on the predicted start time of each pair's next contact)
+advances the scene: pop the earliest contact, integrate it (the solver-specific
+``integrate_contact``), then predict that pair's next contact in closed form and push it back.
+With a rigid plate the balls are independent, so each pair is only ever the ball-plate pair.
+
+Adding ball-ball contact (tailbeam.physics.contact_law.ball_ball_law) fits this design: a ball-ball
+pair's next contact is the first root of |x_i(t) - x_j(t)| = R_i + R_j for two ballistic
+flights (a quartic with gravity cancelling: a quadratic in t), pushed into the same heap; a
+popped prediction is discarded when either ball's trajectory changed since it was made (a
+version counter per ball), and a contact involving a ball already in contact integrates the
+coupled state of all balls in the overlapping contacts together.
+"""
+
+import heapq
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tailbeam.errors import WorkLimitError
+from tailbeam.solvers.records import EventKind
+from tailbeam.solvers.rigid.model import Pair, time_to_contact
+from tailbeam.solvers.rigid.result import Impact, RigidResult
+from tailbeam.solvers.rigid.trajectory import TrajectoryBuilder
+
+
+@dataclass
+class ContactOutcome:
+    """What a contact integrator reports, in the local time tau = t - t_contact (s)."""
+
+    status: str  # "separated", "rest" (rule B) or "duration" (the simulation ended)
+    tau_end: float
+    v_out: float
+    peak_force: float
+    tau_peak: float
+    max_penetration: float
+    events: list  # (tau, kind)
+    tau_start: np.ndarray  # dense-output pieces: validity start, step origin, step, y0, coef
+    tau_old: np.ndarray
+    step: np.ndarray
+    y_old: np.ndarray
+    coef: np.ndarray
+    nfev: int
+    n_steps: int
+    info: dict = field(default_factory=dict)
+
+
+def run(pairs, plate, balls, laws, duration, integrate_contact, *, max_contacts, max_steps):
+    """Simulate all pairs on [0, duration]; ``integrate_contact(pair, v_in, tau_max,
+    max_steps)`` -> ContactOutcome integrates one contact starting at penetration 0."""
+    states = []
+    heap = []
+    for i, p in enumerate(pairs):
+        st = _BallState(p)
+        states.append(st)
+        _predict(st, plate, duration, heap, i)
+    while heap:
+        _, i = heapq.heappop(heap)
+        st = states[i]
+        _contact(st, integrate_contact, duration, max_contacts, max_steps)
+        if not st.done:
+            _predict(st, plate, duration, heap, i)
+
+    impacts = sorted((imp for st in states for imp in st.impacts), key=lambda m: m.t_start)
+    events = sorted((ev for st in states for ev in st.events), key=lambda ev: ev[0])
+    trajectories = {
+        st.pair.name: st.builder.build(st.pair.radius, st.pair.mass, law, st.pair.gravity)
+        for st, law in zip(states, laws, strict=True)
+    }
+    return RigidResult(
+        balls=tuple(balls),
+        laws=tuple(laws),
+        duration=float(duration),
+        gravity=pairs[0].gravity,
+        impacts=impacts,
+        events=events,
+        rest_time={st.pair.name: st.rest_time for st in states},
+        trajectories=trajectories,
+        nfev=sum(st.nfev for st in states),
+        n_steps=sum(st.n_steps for st in states),
+        status=0,
+        message="reached the end of the simulation (duration)",
+        plate=plate,
+    )
+
+
+class _BallState:
+    def __init__(self, pair: Pair):
+        self.pair = pair
+        self.t, self.z, self.vz = 0.0, pair.position[2], pair.velocity[2]
+        self.builder = TrajectoryBuilder()
+        self.impacts, self.events = [], []
+        self.rest_time = math.nan
+        self.nfev = self.n_steps = 0
+        self.done = False
+        self.t_contact = self.v_in = math.nan
+
+
+def _predict(st: _BallState, plate, duration, heap, i):
+    """Close the current flight at the next contact, or run it to the end."""
+    p = st.pair
+    tau, v_in = time_to_contact(max(st.z - p.radius, 0.0), st.vz, p.gravity)
+    tc = st.t + tau
+    if not tc < duration or not p.contains(plate, tc):
+        st.builder.flight(st.t, st.z, st.vz)  # flies to the end (or falls past the plate)
+        st.done = True
+        return
+    if tau > 0.0:
+        st.builder.flight(st.t, st.z, st.vz)
+    st.t_contact, st.v_in = tc, v_in
+    heapq.heappush(heap, (tc, i))
+
+
+def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_steps):
+    p = st.pair
+    tc, v_in = st.t_contact, st.v_in
+    index = len(st.impacts) + 1
+    if index > max_contacts:
+        raise WorkLimitError(
+            f"ball {p.name!r}: more than max_contacts={max_contacts} contacts before "
+            f"t = {tc:.6g} s; raise max_contacts, or rest_speed (now {p.rest_speed} m/s) to "
+            "declare slow bounces at rest sooner"
+        )
+    st.events.append((tc, p.name, EventKind.CONTACT_START))
+    if p.e_rest > 0.0 and p.excess_energy(0.0, v_in) <= p.e_rest:
+        # Touching with (almost) no energy to spare: at rest at once (rule B at first touch).
+        _rest(st, tc, index, v_in, 0.0, tc)
+        return
+    out = integrate_contact(p, v_in, duration - tc, max_steps - st.n_steps)
+    st.nfev += out.nfev
+    st.n_steps += out.n_steps
+    st.builder.contact_pieces(tc, out.tau_start, out.tau_old, out.step, out.y_old, out.coef)
+    for tau, kind in out.events:
+        st.events.append((tc + tau, p.name, kind))
+    t_end = tc + out.tau_end
+    at_rest = out.status == "rest" or (out.status == "separated" and out.v_out < p.rest_speed)
+    v_out = {"separated": out.v_out, "rest": 0.0}.get(out.status, math.nan)
+    apex = v_out**2 / (2.0 * p.gravity) if p.gravity > 0.0 and out.status == "separated" else None
+    st.impacts.append(
+        Impact(
+            ball=p.name,
+            index=index,
+            t_start=tc,
+            t_end=t_end,
+            v_in=v_in,
+            v_out=v_out,
+            restitution=v_out / v_in if v_in > 0.0 else math.nan,
+            peak_force=out.peak_force,
+            t_peak=tc + out.tau_peak,
+            max_penetration=out.max_penetration,
+            next_apex_height=math.nan if (apex is None or at_rest) else apex,
+            ends_at_rest=at_rest,
+        )
+    )
+    if at_rest:
+        st.events.append((t_end, p.name, EventKind.REST))
+        st.builder.rest(t_end, p.radius - p.delta_static, p.mass * p.gravity)
+        st.rest_time = t_end
+        st.done = True
+    elif out.status == "duration":
+        st.done = True
+    else:
+        st.t, st.z, st.vz = t_end, p.radius, out.v_out
+
+
+def _rest(st, tc, index, v_in, v_out, t_end):
+    p = st.pair
+    st.impacts.append(
+        Impact(
+            p.name,
+            index,
+            tc,
+            t_end,
+            v_in,
+            v_out,
+            math.nan if v_in == 0.0 else v_out / v_in,
+            p.mass * p.gravity,
+            tc,
+            p.delta_static,
+            math.nan,
+            True,
+        )
+    )
+    st.events.append((t_end, p.name, EventKind.REST))
+    st.builder.rest(t_end, p.radius - p.delta_static, p.mass * p.gravity)
+    st.rest_time = t_end
+    st.done = True
