@@ -10,7 +10,7 @@ from test_coupled_fe import IMPACT, MESHES, SENSOR, R, _basis, runs  # noqa: F40
 
 import tailbeam as tb
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.io.scene_file import loads_scene, scene_to_dict
+from tailbeam.io.scene_file import dumps_scene, loads_scene, scene_to_dict
 from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.materials import SANDSTONE
@@ -133,8 +133,15 @@ def test_scene_key_end_to_end(capsys):
         )  # fmt: skip
     )
     assert scene_to_dict(scene)["plate"]["tail"] == "ritz"
+    # always written back (a sweep's case scene must keep it whatever the default is)
     plain = scene_to_dict(loads_scene(SCENE.replace('tail = "ritz"', 'tail = "quasi-static"')))
-    assert "tail" not in plain["plate"]  # quasi-static scenes echo as before this key existed
+    assert plain["plate"]["tail"] == "quasi-static" and plain["plate"]["tail_modes"] == 32
+    assert (
+        loads_scene(
+            dumps_scene(loads_scene(SCENE.replace('tail = "ritz"', 'tail = "quasi-static"')))
+        ).modal.tail
+        == "quasi-static"
+    )
     assert scene_to_dict(loads_scene(SCENE.replace('tail = "ritz"', "")))["plate"]["tail"] == "auto"
     res = tb.simulate(scene)
     assert res.info["tail"]["k"] == 32 and res.info["tail"]["points"] == 1
@@ -244,3 +251,19 @@ def test_auto_tail_on_the_stream_solver_runs(capsys):
     assert inclined.modal.tail == "auto"
     assert len(tb.simulate(inclined).impacts) == 1
     assert "tail: quasi-static (the stream solver" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("tail", ["quasi-static", "ritz", "auto"])
+def test_a_sweep_case_keeps_the_tail_of_its_base_scene(tail):
+    # the case scenes of a sweep are the base scene written back (scene_dump): a tail set in
+    # the base must survive it, the default's included
+    import tomllib
+
+    from tailbeam.study.design import expand, parse_sweep
+
+    base = tomllib.loads(SCENE.replace('tail = "ritz"', f'tail = "{tail}"\ntail_modes = 8'))
+    base["sensors"] = [{"name": "S1", "position": [0.1, 0.15], "sample_rate": 51200.0}]
+    cases = expand(parse_sweep({"scene": base, "axes": {"balls.a.radius": [0.02, 0.03]}}))
+    for case in cases:
+        modal = loads_scene(case.toml).modal
+        assert (modal.tail, modal.tail_modes) == (tail, 8)

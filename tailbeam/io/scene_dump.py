@@ -38,8 +38,9 @@ def scene_to_dict(scene: Scene) -> dict:
             plate["fmax"] = m.fmax_hz
         if m.mesh_divisions is not None:
             plate["mesh_divisions"] = m.mesh_divisions
-        if m.tail != "quasi-static":  # written only when set: earlier scenes echo as before
-            plate.update(tail=m.tail, tail_modes=m.tail_modes)
+        # always written: the default changed ("quasi-static" -> "auto") and a dumped scene
+        # (a sweep case, impacts.json) must mean the same run whatever the default is
+        plate.update(tail=m.tail, tail_modes=m.tail_modes)
     used = {b.material for b in scene.balls} | {p.material}
     used |= {m for s in scene.streams for m in (s.coal_material, s.gangue_material)}
     materials = {
