@@ -72,8 +72,10 @@ class KrylovTail:
 
     def __init__(self, basis, loads):
         self.model, self.kept = basis.fe_model(), basis.mode_vectors
+        self.mass_kept = _mass_kept(basis)  # M Phi_kept, so projections need no sparse product
         self.loads = np.asarray(loads, dtype=float).reshape(self.kept.shape[0], -1)
         self.buf = np.zeros((self.kept.shape[0], 16 * self.loads.shape[1]))
+        self.mbuf = np.zeros_like(self.buf)  # M times each column of buf
         self.count = 0  # columns of buf in use
         self.ends = [0]  # columns in use after each Krylov step
         self.block = None  # the next step's vectors, before orthogonalisation
@@ -81,32 +83,34 @@ class KrylovTail:
 
     def extend(self, k: int) -> None:
         """Grow the space to k Krylov steps (or until it is exhausted)."""
-        M, solve = self.model.mass, self.model.solver().solve
+        solve = self.model.solver().solve
         if self.block is None:
             self.block = solve(self.loads)
         while len(self.ends) - 1 < k and not self.exhausted:
-            fresh = [self._add(u, M) for u in self.block.T]
+            fresh = [self._add(u) for u in self.block.T]
             fresh = [c for c in fresh if c is not None]
             self.ends.append(self.count)
             if not fresh:
                 self.exhausted = True
                 break
-            self.block = solve(M @ self.buf[:, fresh])
+            self.block = solve(self.mbuf[:, fresh])
 
-    def _add(self, u, M):
-        """Orthogonalise u (twice is enough: Kahan-Parlett) and append it; its column, or
-        None when it breaks down."""
+    def _add(self, u):
+        """M-orthogonalise u against the kept modes and the space (classical Gram-Schmidt,
+        twice: Kahan-Parlett) and append it; its column, or None when it breaks down."""
+        M = self.model.mass
         start = np.sqrt(u @ (M @ u))
-        V, kept = self.buf[:, : self.count], self.kept
+        V, MV = self.buf[:, : self.count], self.mbuf[:, : self.count]
         for _ in range(2):
-            u = u - kept @ (kept.T @ (M @ u))
-            u = u - V @ (V.T @ (M @ u))
-        norm = np.sqrt(u @ (M @ u))
+            u = u - self.kept @ (self.mass_kept.T @ u) - V @ (MV.T @ u)
+        Mu = M @ u
+        norm = np.sqrt(u @ Mu)
         if norm <= BREAKDOWN * start:
             return None
         if self.count == self.buf.shape[1]:  # room doubles: copies stay O(final size)
             self.buf = np.hstack([self.buf, np.zeros_like(self.buf)])
-        self.buf[:, self.count] = u / norm
+            self.mbuf = np.hstack([self.mbuf, np.zeros_like(self.mbuf)])
+        self.buf[:, self.count], self.mbuf[:, self.count] = u / norm, Mu / norm
         self.count += 1
         return self.count - 1
 
@@ -117,8 +121,22 @@ class KrylovTail:
         if count == 0:  # the loads move no truncated mode
             return np.zeros(0), self.buf[:, :0]
         V = self.buf[:, :count]
-        theta, Y = eigh(V.T @ (self.model.stiffness @ V), V.T @ (self.model.mass @ V))
+        theta, Y = eigh(V.T @ (self.model.stiffness @ V), V.T @ self.mbuf[:, :count])
         return np.sqrt(theta), V @ Y
+
+
+_MASS_KEPT: dict = {}  # id(basis) -> (basis, M Phi_kept), the last KRYLOV_MEMO bases
+
+
+def _mass_kept(basis) -> np.ndarray:
+    """M Phi_kept (n_dofs, modes) of ``basis``, computed once per basis (a sweep's cases share
+    it)."""
+    hit = _MASS_KEPT.get(id(basis))
+    if hit is None or hit[0] is not basis:
+        while len(_MASS_KEPT) >= KRYLOV_MEMO:
+            _MASS_KEPT.pop(next(iter(_MASS_KEPT)))
+        hit = _MASS_KEPT[id(basis)] = (basis, basis.fe_model().mass @ basis.mode_vectors)
+    return hit[1]
 
 
 def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> ModalBasis:
