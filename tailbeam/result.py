@@ -84,10 +84,10 @@ class Result:
     """What ``tailbeam.simulate`` returns, whichever solver ran (see the module docstring).
 
     A subclass provides ``duration`` (s), ``status``, ``message``, ``info``, ``impacts``,
-    ``events``, ``leaves`` and the three hooks ``particle_records()`` (every body as a
-    ``tailbeam.streams.generator.Particle``), ``_impact_rows()`` ((twelve historical values,
-    ``ContactRecord``) per impacts.csv row, in row order) and ``_event_rows()`` ((t s, ball,
-    kind, partner) in time order).
+    ``events`` (``tailbeam.solvers.records.Event`` records in time order), ``leaves`` and the
+    two hooks ``particle_records()`` (every body as a ``tailbeam.streams.generator.Particle``)
+    and ``_impact_rows()`` ((twelve historical values, ``ContactRecord``) per impacts.csv row,
+    in row order).
     """
 
     plate_model = "rigid"  # "rigid" or "modal": the plate the solver ran
@@ -97,9 +97,6 @@ class Result:
         raise NotImplementedError
 
     def _impact_rows(self):
-        raise NotImplementedError
-
-    def _event_rows(self):
         raise NotImplementedError
 
     def impacts_table(self) -> dict:
@@ -138,9 +135,10 @@ class Result:
 
     def events_of(self, name: str, kind: str | None = None) -> list:
         """(t s, kind) of the ball's events in time order, optionally only those of ``kind``
-        (``contact_start``, ``contact_end``, ``rest``, ...: tailbeam.solvers.records)."""
+        (``contact_start``, ``contact_end``, ``rest``, ...: the ``EventKind`` of
+        tailbeam.solvers.records, which equals its value string)."""
         kind = None if kind is None else str(getattr(kind, "value", kind))
-        return [(t, k) for t, b, k, _p in self._event_rows() if b == name and kind in (None, k)]
+        return [(e.t, e.kind) for e in self.events if e.ball == name and kind in (None, e.kind)]
 
     def sample(self, times) -> dict:
         """Ball states at ``times``: only the single-ball solvers keep them (BallsResult)."""
@@ -173,8 +171,8 @@ class Result:
 
 class BallsResult(Result):
     """The single-ball solvers' common part (rigid and modal plate): ``impacts`` are
-    ``tailbeam.solvers.rigid.Impact`` records, ``events`` (t, ball, kind) triples, the balls move
-    laterally at their constant initial velocity. A subclass provides ``balls``,
+    ``tailbeam.solvers.rigid.Impact`` records, ``events`` ``Event`` records (partner ``plate``),
+    the balls move laterally at their constant initial velocity. A subclass provides ``balls``,
     ``labels`` (one per ball; empty: ``tailbeam.scene.default_label``), ``_plate()`` (the
     ``tailbeam.physics.bodies.Plate``, or None when unknown) and ``nfev``, ``n_steps``."""
 
@@ -210,9 +208,6 @@ class BallsResult(Result):
         for imp in self.impacts:
             twelve = tuple(getattr(imp, c) for c in IMPACT_COLUMNS)
             yield twelve, _plate_record(imp, balls[imp.ball])
-
-    def _event_rows(self):
-        return [(t, b, k, PLATE) for t, b, k in self.events]
 
     def _times(self, times, slack: float = 0.0) -> np.ndarray:
         """``times`` (s) as a 1-D float array, checked finite and within [0, duration]

@@ -60,7 +60,7 @@ def test_ball_plate_contact_matches_rigid_solver(damping, exponent):
                              (s.pen, imp.max_penetration)):  # fmt: skip
             assert ours[0] == pytest.approx(theirs, rel=1e-10)
         t = end.t
-    kinks = [(t, k) for t, _, k in rigid.events if k not in ("contact_start", "contact_end")]
+    kinks = [(e.t, e.kind) for e in rigid.events if e.kind not in ("contact_start", "contact_end")]
     kinks = [(tk, k) for tk, k in kinks if tk < t and damping > 0.0]  # (no kink if c = 0)
     if exponent == 1.5:  # (with e = 1 the penetration stays below d: no kink)
         assert len(kinks) == (4 if damping else 0)  # d crossed in and out in both contacts

@@ -101,7 +101,7 @@ def test_clamp_never_acts_at_defaults(results):
     off = run_all(ContactSettings(clamp=False))
     for key, on in results.items():
         assert _clamp_criterion(on) < 1.0
-        assert not [e for e in on.events if e[2] == "clamp_on"]
+        assert not [e for e in on.events if e.kind == "clamp_on"]
         # Without the clamp the paper's literal eq. 1 gives the same impacts.
         for a, b in zip(on.impacts, off[key].impacts, strict=True):
             assert a.restitution == pytest.approx(b.restitution, rel=1e-9)
@@ -117,7 +117,7 @@ def test_without_clamp_restitution_drops_where_the_clamp_acts():
     on = run_all(ContactSettings(**settings))
     off = run_all(ContactSettings(clamp=False, **settings))
     for key in SCENARIOS:
-        assert [e for e in on[key].events if e[2] == "clamp_on"]
+        assert [e for e in on[key].events if e.kind == "clamp_on"]
         for ball in on[key].balls:
             first_on = on[key].impacts_of(ball.name)[0]
             first_off = off[key].impacts_of(ball.name)[0]

@@ -86,7 +86,7 @@ def test_very_large_damping_comes_to_rest_at_static_penetration():
     imp = res.impacts[0]
     assert imp.ends_at_rest and imp.v_out == 0.0 and math.isnan(imp.next_apex_height)
     assert res.rest_time["A"] == imp.t_end < 0.1
-    assert res.events[-1][2] == "rest"
+    assert res.events[-1].kind == "rest"
     delta_s = (m * G / law.stiffness) ** (1.0 / law.exponent)
     s = res.sample([imp.t_end, 0.1])["A"]
     np.testing.assert_allclose(s["z"], R - delta_s, rtol=1e-15)
@@ -186,7 +186,7 @@ def test_stored_trajectory_is_continuous_across_pieces():
     # the motion is C1 in z (velocity continuous) and the force continuous at every contact
     # start/end and kink: evaluating the pieces on both sides of each event must agree
     res = simulate_rigid([_ball(2.0, gap=0.1)], PLATE, [_law()], 0.5, rtol=1e-12)
-    times = np.array([t for t, _, k in res.events if k != "rest"])
+    times = np.array([e.t for e in res.events if e.kind != "rest"])
     assert times.size >= 10
     eps = 1e-13  # s; over it z moves < 3e-13 m and vz by < 3e-9 m/s (|a| < 3e4 m/s^2)
     before = res.sample(times - eps)["A"]

@@ -86,7 +86,7 @@ def test_result_types_and_table():
     assert all(isinstance(i, Impact) for i in res.impacts)
     row = res.table()[0]
     assert row["ball"] == "A" and row["index"] == 1 and isinstance(row["peak_force"], float)
-    kinds = {k for _, _, k in res.events}
+    kinds = {e.kind for e in res.events}
     assert kinds <= {"contact_start", "full_damping", "clamp_on", "clamp_off", "contact_end"}
     grid = res.time_grid(1000.0)
     assert grid[0] == 0.0 and grid[-1] == 0.5 and np.all(np.diff(grid) > 0)

@@ -167,7 +167,7 @@ def test_ten_ball_energy(ten_balls):
     else:
         assert np.max(np.diff(res.energy)) <= 1e-12 * scale
         assert res.energy[-1] < res.energy[0] - 1e-3 * scale  # it did dissipate
-        kinds = {e[1] for e in res.events}
+        kinds = {e.kind for e in res.events}
         assert {EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF} <= kinds
 
 
@@ -214,7 +214,7 @@ def test_release_times_and_a_generated_stream():
         balls, InclinedPlate(inclination=20.0), 0.25, damping=1000.0,
         release_times=[p.t_release for p in particles],
     )  # fmt: skip
-    released = {e[2]: e[0] for e in res.events if e[1] == EventKind.RELEASE}
+    released = {e.ball: e.t for e in res.events if e.kind == EventKind.RELEASE}
     for p in particles:
         if p.t_release > 0.0:
             assert released[p.name] == p.t_release

@@ -45,7 +45,7 @@ def clamp_summary(results, results_off, claims_off) -> str:
             changes.append(off - on)
     worst = max(changes, key=abs)
     n = sum(c.passed for c in claims_off)
-    acted = sum(1 for r in results.values() for e in r.events if e[2] == EventKind.CLAMP_ON)
+    acted = sum(1 for r in results.values() for e in r.events if e.kind == EventKind.CLAMP_ON)
     return (
         f"without Adams' clamp (eq. 1 as printed): {n} of {len(claims_off)} claims hold; "
         f"largest change of first-impact restitution {worst:+.3g} "

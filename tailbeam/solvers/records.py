@@ -1,12 +1,14 @@
-"""What the solvers report: event kinds, contact (impact) records and leave events.
+"""What the solvers report: event kinds, event records, contact (impact) records, leaves.
 
-``EventKind`` is the one table of event kinds of every solver (rigid, coupled, stream, and
-their references); ``ContactRecord`` and ``LeaveEvent`` are the stream solvers' records (the
-refactor of issue 7 extends them to every solver).
+``EventKind`` is the one table of event kinds and ``Event`` the one event record of every
+solver (rigid, coupled two-way and one-way, stream, and their references): each appends
+``Event(t, ball, kind, partner)`` to its ``events``. ``ContactRecord`` and ``LeaveEvent``
+are the stream solvers' records (the refactor of issue 7 extends them to every solver).
 """
 
 from dataclasses import asdict, dataclass
 from enum import Enum
+from typing import NamedTuple
 
 PLATE = "plate"  # the partner name of a ball-plate contact
 
@@ -29,6 +31,29 @@ class EventKind(str, Enum):
 
     def __format__(self, spec: str) -> str:
         return format(self.value, spec)
+
+
+class Event(NamedTuple):
+    """One event of one ball, as every solver records it (``result.events``, time order).
+
+    Parameters
+    ----------
+    t : float
+        Time of the event (s).
+    ball : str
+        Name of the ball the event belongs to.
+    kind : EventKind
+        What happened (contact start or end, a kink of the law, leave, release, rest).
+    partner : str
+        The other body: ``plate`` (``PLATE``) or the other ball's name for the contact
+        events and kinks, and for ``rest`` (on the plate); the edge passed (``x+``, ...) for
+        ``leave``; ``""`` for ``release``.
+    """
+
+    t: float
+    ball: str
+    kind: EventKind
+    partner: str
 
 
 @dataclass

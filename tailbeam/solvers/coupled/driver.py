@@ -18,7 +18,7 @@ from tailbeam.solvers.coupled import kernel as K
 from tailbeam.solvers.coupled import step as S
 from tailbeam.solvers.coupled.records import Compliance, close_contact
 from tailbeam.solvers.coupled.result import CoupledResult
-from tailbeam.solvers.records import EventKind
+from tailbeam.solvers.records import PLATE, Event, EventKind
 
 NODE_CAPACITY = 65536  # nodes of the first buffers (they double when full)
 EVENT_NAMES = {
@@ -205,7 +205,7 @@ class CoupledRun:
                 self._mark_rest(b)
 
     def _on_event(self, kind: int, b: int) -> None:
-        self.events.append((self.t, self.balls[b].name, EVENT_NAMES[kind]))
+        self.events.append(Event(self.t, self.balls[b].name, EVENT_NAMES[kind], PLATE))
         if kind == K.EV_START:
             self._start(b)
         elif kind == K.EV_END:
@@ -262,7 +262,7 @@ class CoupledRun:
         """Record ball b's rest (time, event) and a node at this instant."""
         name = self.balls[b].name
         self.rest_time[name] = self.t
-        self.events.append((self.t, name, EventKind.REST))
+        self.events.append(Event(self.t, name, EventKind.REST, PLATE))
         bt, bz, bvz, bF, bd = self.bufs
         if self.nbuf >= len(bt):
             raise WorkLimitError("node buffer full at a rest declaration; raise max_steps")

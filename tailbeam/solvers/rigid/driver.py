@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tailbeam.errors import WorkLimitError
-from tailbeam.solvers.records import EventKind
+from tailbeam.solvers.records import PLATE, Event, EventKind
 from tailbeam.solvers.rigid.model import Pair, time_to_contact
 from tailbeam.solvers.rigid.result import Impact, RigidResult
 from tailbeam.solvers.rigid.trajectory import TrajectoryBuilder
@@ -36,7 +36,7 @@ class ContactOutcome:
     peak_force: float
     tau_peak: float
     max_penetration: float
-    events: list  # (tau, kind)
+    events: list  # (tau, EventKind) in local time: the driver records them as Event
     tau_start: np.ndarray  # dense-output pieces: validity start, step origin, step, y0, coef
     tau_old: np.ndarray
     step: np.ndarray
@@ -64,7 +64,7 @@ def run(pairs, plate, balls, laws, duration, integrate_contact, *, max_contacts,
             _predict(st, plate, duration, heap, i)
 
     impacts = sorted((imp for st in states for imp in st.impacts), key=lambda m: m.t_start)
-    events = sorted((ev for st in states for ev in st.events), key=lambda ev: ev[0])
+    events = sorted((ev for st in states for ev in st.events), key=lambda ev: ev.t)
     trajectories = {
         st.pair.name: st.builder.build(st.pair.radius, st.pair.mass, law, st.pair.gravity)
         for st, law in zip(states, laws, strict=True)
@@ -123,7 +123,7 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
             f"t = {tc:.6g} s; raise max_contacts, or rest_speed (now {p.rest_speed} m/s) to "
             "declare slow bounces at rest sooner"
         )
-    st.events.append((tc, p.name, EventKind.CONTACT_START))
+    st.events.append(Event(tc, p.name, EventKind.CONTACT_START, PLATE))
     if p.e_rest > 0.0 and p.excess_energy(0.0, v_in) <= p.e_rest:
         # Touching with (almost) no energy to spare: at rest at once (rule B at first touch).
         _rest(st, tc, index, v_in, 0.0, tc)
@@ -133,7 +133,7 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
     st.n_steps += out.n_steps
     st.builder.contact_pieces(tc, out.tau_start, out.tau_old, out.step, out.y_old, out.coef)
     for tau, kind in out.events:
-        st.events.append((tc + tau, p.name, kind))
+        st.events.append(Event(tc + tau, p.name, kind, PLATE))
     t_end = tc + out.tau_end
     at_rest = out.status == "rest" or (out.status == "separated" and out.v_out < p.rest_speed)
     v_out = {"separated": out.v_out, "rest": 0.0}.get(out.status, math.nan)
@@ -155,7 +155,7 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
         )
     )
     if at_rest:
-        st.events.append((t_end, p.name, EventKind.REST))
+        st.events.append(Event(t_end, p.name, EventKind.REST, PLATE))
         st.builder.rest(t_end, p.radius - p.delta_static, p.mass * p.gravity)
         st.rest_time = t_end
         st.done = True
@@ -183,7 +183,7 @@ def _rest(st, tc, index, v_in, v_out, t_end):
             True,
         )
     )
-    st.events.append((t_end, p.name, EventKind.REST))
+    st.events.append(Event(t_end, p.name, EventKind.REST, PLATE))
     st.builder.rest(t_end, p.radius - p.delta_static, p.mass * p.gravity)
     st.rest_time = t_end
     st.done = True

@@ -95,9 +95,8 @@ def run_reference(particles, incline, duration, *, laws, rtol, max_steps, progre
         release_times=[p.t_release for p in particles],
         progress=progress,
     )
-    events = [(t, ball, kind, partner) for t, kind, ball, partner in ref.events]
     stats = {"n_steps": ref.steps, "n_contacts": len(ref.contacts), "n_leaves": len(ref.leaves)}
     return StreamResult(
-        list(particles), ref.contacts, ref.leaves, events, incline, duration,
+        list(particles), ref.contacts, ref.leaves, ref.events, incline, duration,
         status=0, message="reached the end of the simulation", stats=stats, info=dict(ref.info),
     )  # fmt: skip

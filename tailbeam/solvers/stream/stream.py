@@ -35,7 +35,7 @@ from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.contact_law import HERTZ_EXPONENT, elastic_energy
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import note, quiet, task
-from tailbeam.solvers.records import PLATE, EventKind, LeaveEvent
+from tailbeam.solvers.records import PLATE, Event, EventKind, LeaveEvent
 from tailbeam.solvers.stream.broadphase import candidate_pairs
 from tailbeam.solvers.stream.stream_records import StreamRecords
 from tailbeam.solvers.stream.stream_state import ACTIVE, FLY, GONE, SLIDE, Balls, LawOptions
@@ -86,9 +86,8 @@ def simulate_stream(
         clamp=laws.clamp, exponent=laws.exponent, rtol=rtol, rest_speed=rest_speed,
         max_work=max_steps, progress=progress, plate=plate,
     )  # fmt: skip
-    events = [(t, ball, kind, partner) for t, kind, ball, partner in run.events]
     result = StreamResult(
-        run.particles, run.contacts, run.leaves, events, incline, duration,
+        run.particles, run.contacts, run.leaves, run.events, incline, duration,
         status=run.status, message=run.message, stats=run.stats,
         info={"solver": "fast stream solver (event-driven, active-set DOP853)"},
     )  # fmt: skip
@@ -310,7 +309,7 @@ class _Stream(StreamRecords):
         for t, name, p in self.act.kinks:
             i, j = self.act.keys[p]
             partner = PLATE if j < 0 else self.balls.names[j]
-            self.events.append((t, EventKind(name), self.balls.names[i], partner))
+            self.events.append(Event(t, self.balls.names[i], EventKind(name), partner))
 
     def _handle(self, entry):
         t, kind, _seq, i, j, vi, vj, edge = entry
@@ -349,7 +348,7 @@ class _Stream(StreamRecords):
         x, v = b.state(i, self.t)
         on_plate = float(elastic_energy(b.radius[i] - x[2], b.plate_laws[i]))  # released there
         self.stats["energy_released"] += self._ball_energy(i, x, v) + on_plate
-        self.events.append((self.t, EventKind.RELEASE, b.names[i], ""))
+        self.events.append(Event(self.t, b.names[i], EventKind.RELEASE, ""))
         self._predict(i)
         if self.act.members:
             self._refresh_set()
@@ -432,7 +431,7 @@ class _Stream(StreamRecords):
         b.status[i] = GONE
         b.version[i] += 1
         self.leaves.append(LeaveEvent(b.names[i], t, edge))
-        self.events.append((t, EventKind.LEAVE, b.names[i], edge))
+        self.events.append(Event(t, b.names[i], EventKind.LEAVE, edge))
 
     # --- events of the active set -------------------------------------------------------------
     def _on_start(self, key):
@@ -490,7 +489,7 @@ class _Stream(StreamRecords):
         self.core.discard(i)
         self.landing.discard(i)
         self.leaves.append(LeaveEvent(b.names[i], self.t, edge))
-        self.events.append((self.t, EventKind.LEAVE, b.names[i], edge))
+        self.events.append(Event(self.t, b.names[i], EventKind.LEAVE, edge))
 
     # --- membership -----------------------------------------------------------------------------
     def _persistent_to_rest(self):

@@ -9,7 +9,7 @@ import numpy as np
 
 from tailbeam.physics.contact_law import elastic_energy
 from tailbeam.physics.hertz import hertz_contact_duration
-from tailbeam.solvers.records import PLATE, ContactRecord, EventKind
+from tailbeam.solvers.records import PLATE, ContactRecord, Event, EventKind
 from tailbeam.solvers.stream.stream_state import GONE, PENDING, SLIDE
 
 REST_CONTACT_FACTOR = 50.0  # a plate contact longer than this many Hertz durations is at rest
@@ -47,7 +47,7 @@ class StreamRecords:
         if j < 0:
             self.limit[i] = t + REST_CONTACT_FACTOR * self._hertz_duration(i, recs[0].v_in)
         self.contacts.extend(recs)
-        self.events.append((t, EventKind.CONTACT_START, b.names[i], partner))
+        self.events.append(Event(t, b.names[i], EventKind.CONTACT_START, partner))
 
     def _hertz_duration(self, i: int, speed: float) -> float:
         """Hertz contact duration (s) of ball i on the plate at ``speed`` (>= rest_speed)."""
@@ -66,7 +66,7 @@ class StreamRecords:
         for rec, v_out in zip(recs, outs, strict=True):
             rec.t_end, rec.v_out, rec.approach_out, rec.end = self.t, v_out, float(w @ n), end
             rec.peak_force, rec.t_peak, rec.max_penetration = peak, t_peak, pen
-        self.events.append((self.t, EventKind.CONTACT_END, recs[0].ball, recs[0].partner))
+        self.events.append(Event(self.t, recs[0].ball, EventKind.CONTACT_END, recs[0].partner))
 
     def _flush_nodes(self, i: int):
         """Hand the plate force history of ball i recorded so far to the loads."""

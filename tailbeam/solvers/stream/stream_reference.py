@@ -65,7 +65,7 @@ from tailbeam.physics.contact_law import (
 from tailbeam.physics.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES, InclinedPlate
 from tailbeam.physics.pair import pair_kinematics, plate_foot
-from tailbeam.solvers.records import PLATE, ContactRecord, EventKind, LeaveEvent
+from tailbeam.solvers.records import PLATE, ContactRecord, Event, EventKind, LeaveEvent
 from tailbeam.solvers.stream.reference_plate import ReferencePlate
 from tailbeam.solvers.stream.step_events import (
     STEP_POINTS,
@@ -126,7 +126,7 @@ class _Laws:
 @dataclass
 class StreamReferenceResult:
     """Contacts (one ``ContactRecord`` per ball per contact), leave events, the event log
-    (t, EventKind, ball, partner), and per accepted step: times, total energy (J) and states
+    (``Event`` records in time order), and per accepted step: times, total energy (J) and states
     (names of the balls present, positions (n, 3) m, velocities (n, 3) m/s)."""
 
     names: tuple
@@ -573,7 +573,7 @@ class _Reference:
         return None
 
     def log(self, t, kind, p):
-        self.events.append((t, kind, self.balls[p.i].name, self.partner_name(p)))
+        self.events.append(Event(t, self.balls[p.i].name, kind, self.partner_name(p)))
 
     def partner_name(self, p):
         return PLATE if p.j < 0 else self.balls[p.j].name
@@ -628,7 +628,7 @@ class _Reference:
                 kin, li, lj, _ = self.kinematics([p], x, v, modes)
                 self.close_contact(p, t, kin, v, li[0], lj[0], "left")
         self.leaves.append(LeaveEvent(self.balls[ball].name, t, edge))
-        self.events.append((t, EventKind.LEAVE, self.balls[ball].name, edge))
+        self.events.append(Event(t, self.balls[ball].name, EventKind.LEAVE, edge))
         keep = [q for q, b in enumerate(self.active) if b != ball]
         self.active = [self.active[q] for q in keep]
         self.y = self.join(x[keep], v[keep], modes)
@@ -650,7 +650,7 @@ class _Reference:
             x = np.vstack([x, ball.position])
             v = np.vstack([v, ball.velocity])
             new.extend(self.add_pairs(i))
-            self.events.append((t, EventKind.RELEASE, ball.name, ""))
+            self.events.append(Event(t, ball.name, EventKind.RELEASE, ""))
         self.y = self.join(x, v, modes)
         self.touch(new, t)
         return None

@@ -48,7 +48,7 @@ class StreamResult(Result):
 
     particles: ``tailbeam.streams.generator.Particle`` of every body, ``[[balls]]`` included
     (stream "", t_release 0); contacts: ``ContactRecord`` (one per ball per contact);
-    leaves: ``LeaveEvent``; events: (t, ball, EventKind, partner) in time order; incline:
+    leaves: ``LeaveEvent``; events: ``tailbeam.solvers.records.Event`` in time order; incline:
     ``tailbeam.physics.incline.InclinedPlate``; duration in s; status 0 = reached the end;
     message; stats: solver statistics (steps, ...); sensors: sensor outputs by name once
     the modal plate carries streams (None until then); info: what was chosen.
@@ -95,9 +95,6 @@ class StreamResult(Result):
         for rec in sorted(self.contacts, key=lambda r: (r.t_start, r.ball)):
             count[rec.ball] = count.get(rec.ball, 0) + 1
             yield _twelve(rec, count[rec.ball], g_n, starts, leave), rec
-
-    def _event_rows(self):
-        return [(t, b, str(getattr(k, "value", k)), p) for t, b, k, p in self.events]
 
 
 def _starts_by_ball(contacts) -> dict:
