@@ -7,18 +7,20 @@ numba cache, single-threaded) and compares every number they report: the rigid s
 its scipy reference (paper section 4.1: coal balls at 1 and 2 m/s, c = 800 N s/m, 1 s), the
 two-way coupled modal solver (sandstone at 2 m/s on the closed-form SSSS plate, 5 kHz band,
 c = 800 N s/m, residual flexibility on) and the FE reference (the same ball on Argyris 8x8,
-dt 2e-7 s, 0.4 ms), the stream solver and the stream reference (the ten-ball scene on a 15 deg
-plate, c = 2000 N s/m, d = 2e-5 m: ball-ball contacts, clamp and STEP kinks), the stream
+dt 2e-7 s, 0.4 ms), the stream solver and the stream reference (the ten-ball scene on a
+15 deg plate, c = 2000 N s/m, d = 2e-5 m: ball-ball contacts, clamp and STEP kinks), the stream
 solver on the modal plate. Prints per solver "bit-identical" or the largest difference of
 any number relative to the largest magnitude of its column (and the column), the numeric
 columns whose length changed (an adaptive reference taking other steps), and the non-numeric
-columns (names, event kinds, ends) that differ. ``--quick`` drops the FE reference and the
-stream reference (the slow ones). Exit code 1 if a non-numeric column differs; how large a
-numeric difference is acceptable is the reader's call: the adaptive references take other
-steps after a 1-ulp change of the force, and a 1-ulp change of the stiffness alone moves the
-FE reference's sensor acceleration by 2.4e-6 of its peak (measured on this scene). The
-active set's own bitwise check is ``compare_active_set_revisions.py``. ``--keep DIR`` keeps
-the results there and reuses DIR/old.pkl if present (the base is then not run again).
+columns (names, event kinds, ends) that differ. Events are compared by field (t, ball, kind,
+partner), whichever tuple order the revision wrote them in (``_events``). ``--quick`` drops
+the FE reference and the stream reference (the slow ones). Exit code 1 if a non-numeric
+column differs; how large a numeric difference is acceptable is the reader's call: the
+adaptive references take other steps after a 1-ulp change of the force, and a 1-ulp change
+of the stiffness alone moves the FE reference's sensor acceleration by 2.4e-6 of its peak
+(measured on this scene). The active set's own bitwise check is
+``compare_active_set_revisions.py``. ``--keep DIR`` keeps the results there and reuses
+DIR/old.pkl if present (the base is then not run again).
 """
 
 import argparse
@@ -52,6 +54,25 @@ def _columns(obj, prefix, out):
         out.setdefault(prefix, []).append(str(obj.value))
     else:
         out.setdefault(prefix, []).append(obj)
+
+
+def _events(events) -> list:
+    """Events as dicts (t, ball, kind, partner), whichever record the revision wrote: the
+    ``Event`` record, or before it (issue 7) the single-ball solvers' (t, ball, kind) tuples
+    (partner: the plate) and the stream solvers' (t, kind, ball, partner) tuples."""
+    fields = ("t", "ball", "kind", "partner")
+    out = []
+    for ev in events:
+        if hasattr(ev, "_asdict"):
+            out.append(ev._asdict())
+        elif len(ev) == 3:
+            out.append(dict(zip(fields, (*ev, "plate"), strict=True)))
+        elif isinstance(ev[1], enum.Enum):  # the stream solvers' order
+            t, kind, ball, partner = ev
+            out.append(dict(zip(fields, (t, ball, kind, partner), strict=True)))
+        else:
+            out.append(dict(zip(fields, ev, strict=True)))
+    return out
 
 
 def run_solvers(out_path, quick):
@@ -88,15 +109,15 @@ def run_solvers(out_path, quick):
     runs = {}
     rigid = simulate_rigid(balls, Plate(), [law, law], 1.0, rtol=1e-11)
     grid = rigid.time_grid(5120.0)
-    runs["rigid"] = (rigid.impacts, rigid.events, rigid.sample(grid))
+    runs["rigid"] = (rigid.impacts, _events(rigid.events), rigid.sample(grid))
     ref = simulate_rigid_reference(balls, Plate(), [law, law], 1.0)
-    runs["rigid reference"] = (ref.impacts, ref.events, ref.sample(grid))
+    runs["rigid reference"] = (ref.impacts, _events(ref.events), ref.sample(grid))
 
     basis = ssss_kirchhoff_basis(Plate(), 5000.0)
     ball = Ball("s", SANDSTONE, 0.03, (0.07, -0.05, 0.03 + 1e-4), (0.0, 0.0, -2.0))
     slaw = ball_plate_law(SANDSTONE, 0.03, CARBON_STEEL, damping=800.0)
     coupled = simulate_coupled([ball], basis, [slaw], 2e-3, gravity=9.80665)
-    runs["coupled"] = (coupled.impacts, coupled.events, coupled.nodes)
+    runs["coupled"] = (coupled.impacts, _events(coupled.events), coupled.nodes)
     if not quick:
         from tailbeam.plate import assemble_plate
 
@@ -114,16 +135,16 @@ def run_solvers(out_path, quick):
                       tuple(b.position), tuple(b.velocity)) for b in ten]  # fmt: skip
     opts = dict(damping=2000.0, penetration=2e-5)
     fast = solve_stream(parts, incline, 0.1, rtol=1e-12, rest_speed=0.0, progress=False, **opts)
-    runs["stream"] = (fast.contacts, fast.leaves, fast.events)
+    runs["stream"] = (fast.contacts, fast.leaves, _events(fast.events))
     if not quick:
         sref = simulate_stream_reference(ten, incline, 0.1, **opts)
-        runs["stream reference"] = (sref.contacts, sref.leaves, sref.events, sref.energy)
+        runs["stream reference"] = (sref.contacts, sref.leaves, _events(sref.events), sref.energy)
     plate = StreamPlate(basis, np.full(basis.n_modes, 0.01))
     one = [Particle("s", "", "gangue", SANDSTONE, 0.03, ball.mass, 0.0, tuple(ball.position),
                     tuple(ball.velocity))]  # fmt: skip
     modal = solve_stream(one, InclinedPlate(), 2e-3, damping=800.0, rtol=1e-12, progress=False,
                          plate=plate)  # fmt: skip
-    runs["stream, modal plate"] = (modal.contacts, modal.events)
+    runs["stream, modal plate"] = (modal.contacts, _events(modal.events))
     flat = {}
     for name, result in runs.items():
         flat[name] = {}
