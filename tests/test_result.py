@@ -256,3 +256,26 @@ def test_every_solver_records_the_one_event_record():
     leaves = [e for e in results["stream"].events if e.kind == EventKind.LEAVE]
     assert [(e.ball, e.partner) for e in leaves] == [("m", "x+")]
     assert leaves[0].t == pytest.approx(0.05, rel=1e-9)
+
+
+def test_ball_ball_events_name_the_partner():
+    """Two balls flying head-on (1 m/s each, surfaces 0.02 m apart, 0.2 m above the plate):
+    both stream solvers record the contact's start, kinks and end as ``Event`` records of
+    one ball with the other as partner; the start at the closed-form time 0.02 m / 2 m/s = 0.01 s
+    (gravity moves both alike)."""
+    from tailbeam.solvers.records import Event, EventKind
+    from tailbeam.solvers.stream.engine import run_reference
+
+    pair = (Ball("a", COAL, 0.02, (-0.03, 0.0, 0.2), (1.0, 0.0, 0.0)),
+            Ball("b", COAL, 0.02, (0.03, 0.0, 0.2), (-1.0, 0.0, 0.0)))  # fmt: skip
+    scene = Scene(pair, duration=0.02)
+    args = (scene.particles, scene.incline, scene.duration)
+    kw = dict(laws=scene.contact, rtol=1e-10, max_steps=10**6)
+    for solver in (stream_engine().run, run_reference):
+        events = [e for e in solver(*args, **kw).events if e.kind != EventKind.RELEASE]
+        assert all(type(e) is Event for e in events)
+        kinds = [e.kind for e in events]  # the law's kinks (full damping, clamp) in between
+        assert kinds[0] == "contact_start" and kinds[-1] == "contact_end", kinds
+        assert "contact_start" not in kinds[1:] and "contact_end" not in kinds[:-1], kinds
+        assert all({e.ball, e.partner} == {"a", "b"} for e in events)
+        assert events[0].t == pytest.approx(0.01, rel=1e-9)
