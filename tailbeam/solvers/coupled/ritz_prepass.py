@@ -1,6 +1,7 @@
-"""The Ritz tail of the coupled solver (``plate.tail = "ritz"``): a pre-pass over the balls'
-first contact points that adds load-dependent Ritz pseudo-modes of the truncated modes there
-(tailbeam.plate.ritz_tail) to the modal basis before the run.
+"""The Ritz tail of the coupled solver (``plate.tail = "ritz"``, and the default "auto" where
+it applies: ``apply_tail``): a pre-pass over the balls' first contact points that adds
+load-dependent Ritz pseudo-modes of the truncated modes there (tailbeam.plate.ritz_tail) to
+the modal basis before the run.
 
 The first contact of every ball is known in closed form on the horizontal plate: free fall z(t) =
 gap + vz t - g t^2 / 2 of the ball's lowest point to the undeformed plate, at (x0 + vx t_hit, y0 +
@@ -16,9 +17,10 @@ contact (later contacts elsewhere keep the quasi-static residual of the augmente
 static minus every mode held), and the sensors' quasi-static correction (the residual cross
 compliance of the augmented basis), without double counting.
 
-k per point: ``plate.tail_modes`` (a whole number), or "auto": ``choose_ritz_k`` per point from
-the Hertz estimate of the ball's first impact on a rigid plate (duration, peak force, maximum
-penetration at the speed after its fall), tolerance AUTO_TOL; the block uses the largest k.
+k per point: ``plate.tail_modes`` (a whole number, default 32), or "auto": ``choose_ritz_k``
+per point from the Hertz estimate of the ball's first impact on a rigid plate (duration, peak
+force, maximum penetration at the speed after its fall), tolerance AUTO_TOL; the block uses
+the largest k.
 """
 
 import math
