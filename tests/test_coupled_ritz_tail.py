@@ -226,7 +226,8 @@ def test_augmented_basis_keeps_the_kept_shapes_and_repeats_itself():
         ({}, "closed form"),  # the Navier basis passed below
         ({"residual_flexibility": False}, "residual_flexibility is off"),
         ({"coupling": "one-way"}, "one-way coupling"),
-        ({"tail_modes": 600}, "600 Ritz modes x 2"),  # > MAX_RITZ_VECTORS over two points
+        ({"tail_modes": 600}, "2 first-contact points x 600 pseudo-modes > 128"),
+        ({"tail_modes": 65}, "2 first-contact points x 65 pseudo-modes > 128"),  # the budget
     ],
 )
 def test_auto_tail_keeps_the_quasi_static_tail_where_ritz_does_not_apply(capsys, modal, reason):
@@ -267,3 +268,14 @@ def test_a_sweep_case_keeps_the_tail_of_its_base_scene(tail):
     for case in cases:
         modal = loads_scene(case.toml).modal
         assert (modal.tail, modal.tail_modes) == (tail, 8)
+
+
+def test_auto_tail_builds_up_to_its_budget():
+    # 2 first contacts x 64 pseudo-modes = AUTO_RITZ_BUDGET: still built (65: kept out, above)
+    balls = [Ball(n, SANDSTONE, R, (x, 0.03, R + 1e-5), (0.0, 0.0, -1.0))
+             for n, x in (("a", 0.05), ("b", -0.1))]  # fmt: skip
+    scene = _scene(balls, duration=2e-4, tail_modes=64)
+    basis = _basis("kirchhoff", fmax_hz=BAND)
+    res = simulate_scene_modal(scene, basis=basis)
+    assert res.info["tail"]["model"] == "ritz" and res.info["tail"]["added_modes"] == 128
+    assert res.basis.n_modes == basis.n_modes + 128

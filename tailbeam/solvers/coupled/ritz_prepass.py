@@ -35,6 +35,7 @@ from tailbeam.progress import note, task
 from tailbeam.scene import DEFAULT_TAIL_MODES
 
 AUTO_TOL = 1e-5  # choose_ritz_k's tolerance (relative to the max penetration)
+AUTO_RITZ_BUDGET = 128  # pseudo-modes (k x points) plate.tail = "auto" builds at most
 AUTO_K_MAX = 512  # choose_ritz_k's k_max per point (fewer if the points share MAX_RITZ_VECTORS)
 MIN_SPEED = 1e-3  # m/s, the impact speed floor of the band's contact estimate (auto.py)
 
@@ -163,12 +164,13 @@ def apply_tail(scene, basis, settings):
     "ritz" builds the Ritz tail (errors name plate.tail / plate.tail_modes), "quasi-static"
     keeps ``basis``, "auto" builds it where it applies and otherwise keeps ``basis`` with
     the reason (said on stderr): a basis without an FE model (closed form), residual
-    flexibility off, one-way coupling, or more pseudo-modes than MAX_RITZ_VECTORS."""
+    flexibility off, one-way coupling, more pseudo-modes than AUTO_RITZ_BUDGET (many
+    balls) or than MAX_RITZ_VECTORS."""
     if settings.tail == "ritz":
         return ritz_tail_basis(scene, basis, settings.tail_modes)
     if settings.tail == "quasi-static":
         return basis, {"model": "quasi-static", "reason": "plate.tail"}
-    why = _why_not_ritz(settings, basis)
+    why = _why_not_ritz(settings, basis) or _over_budget(scene, basis, settings.tail_modes)
     if why is None:
         try:
             return ritz_tail_basis(scene, basis, settings.tail_modes)
@@ -189,6 +191,21 @@ def _why_not_ritz(settings, basis) -> str | None:
     except InputError:
         return f"the {basis.theory} {basis.boundary} basis is a closed form, without an FE model"
     return None
+
+
+def _over_budget(scene, basis, tail_modes) -> str | None:
+    """Why "auto" keeps the quasi-static tail for a scene with many first contacts, or None:
+    more than AUTO_RITZ_BUDGET pseudo-modes (k x points; k >= 2 K_START for "auto") would
+    cost more than the run (30 balls on the default plate: 32 s of pre-pass and 960 more
+    modes against a 6 s quasi-static run)."""
+    points = len(_unique(first_contacts(scene, basis.theory)))
+    k = 2 * K_START if tail_modes == "auto" else int(tail_modes)
+    if k * points <= AUTO_RITZ_BUDGET:
+        return None
+    return (
+        f"{points} first-contact points x {k} pseudo-modes > {AUTO_RITZ_BUDGET}, more than the "
+        "run would cost; plate.tail = 'ritz' forces the Ritz tail"
+    )
 
 
 def describe_tail(info: dict) -> str:
