@@ -67,8 +67,7 @@ DEFAULTS = "default settings (tail auto: ritz, k = 32; 200 steps/contact)"
 
 
 def _divisions(theory, full):
-    if isinstance(full, int) and not isinstance(full, bool):
-        return full  # --divisions N
+    """The test mesh, or with ``full`` the default mesh of a 20 kHz band."""
     if not full:
         return TEST_MESHES[theory]
     res = resolve(Plate(), theory=theory, fmax_hz=20000.0, count=None, accuracy=1e-3,
@@ -113,9 +112,9 @@ def _default_settings(case, basis, ref, theory, band, divisions):
     return dict(result_errors(case, res, ref), n_modes=res.basis.n_modes)
 
 
-def study_theory(theory, full, dt, steps, bands=BANDS):
-    """Rows of (theory, band, n_modes, variant, contact error, sensor error) for one theory."""
-    divisions = _divisions(theory, full)
+def study_theory(theory, divisions, dt, steps, bands=BANDS):
+    """Rows of (theory, band, n_modes, variant, contact error, sensor error) for one theory
+    on the mesh of ``divisions`` elements per side."""
     plate = Plate()
     model = assemble_plate(plate, "SSSS", theory=theory, divisions=divisions)
     ball = Ball("b", SANDSTONE, R, (*IMPACT, R + 1e-5), (0.0, 0.0, -1.0))
@@ -264,9 +263,8 @@ def main(argv=None):
     theories = ("kirchhoff", "mindlin") if args.theory == "both" else (args.theory,)
     rows, meta = [], []
     for theory in theories:
-        r, divisions, n_dofs, st = study_theory(
-            theory, args.divisions or args.full, args.dt, args.steps, args.bands
-        )
+        divisions = args.divisions or _divisions(theory, args.full)
+        r, divisions, n_dofs, st = study_theory(theory, divisions, args.dt, args.steps, args.bands)
         rows += r
         est = max(st["error_estimate"].values())
         order = min(min(v) for v in st["orders"].values())

@@ -56,11 +56,17 @@ def krylov_tail(basis, loads) -> "KrylovTail":
     loads (choose_ritz_k grows it to 2k; the build with k then only projects it)."""
     loads = np.asarray(loads, dtype=float)
     key = (id(basis), loads.shape, loads.tobytes())
-    hit = _KRYLOV.get(key)
+    return _remember(_KRYLOV, key, basis, lambda: KrylovTail(basis, loads))
+
+
+def _remember(store: dict, key, basis, build):
+    """``store[key]``'s value if it was built for this very ``basis`` (ids are reused once a
+    basis is gone), else ``build()`` kept there; the store holds the last KRYLOV_MEMO."""
+    hit = store.get(key)
     if hit is None or hit[0] is not basis:
-        while len(_KRYLOV) >= KRYLOV_MEMO:
-            _KRYLOV.pop(next(iter(_KRYLOV)))
-        hit = _KRYLOV[key] = (basis, KrylovTail(basis, loads))
+        while len(store) >= KRYLOV_MEMO:
+            store.pop(next(iter(store)))
+        hit = store[key] = (basis, build())
     return hit[1]
 
 
@@ -131,12 +137,8 @@ _MASS_KEPT: dict = {}  # id(basis) -> (basis, M Phi_kept), the last KRYLOV_MEMO 
 def _mass_kept(basis) -> np.ndarray:
     """M Phi_kept (n_dofs, modes) of ``basis``, computed once per basis (a sweep's cases share
     it)."""
-    hit = _MASS_KEPT.get(id(basis))
-    if hit is None or hit[0] is not basis:
-        while len(_MASS_KEPT) >= KRYLOV_MEMO:
-            _MASS_KEPT.pop(next(iter(_MASS_KEPT)))
-        hit = _MASS_KEPT[id(basis)] = (basis, basis.fe_model().mass @ basis.mode_vectors)
-    return hit[1]
+    return _remember(_MASS_KEPT, id(basis), basis,
+                     lambda: basis.fe_model().mass @ basis.mode_vectors)  # fmt: skip
 
 
 def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> ModalBasis:
