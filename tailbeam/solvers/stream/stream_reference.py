@@ -7,7 +7,8 @@ step through its ``OdeSolver`` class so that every step can be checked for conta
 1e-12 by default). Every pair is watched (O(N^2): this is the slow reference):
 
 * ball-ball and ball-plate contacts use the IMPACT law of ``tailbeam.physics.contact_law``
-  (``ball_ball_law``: R = R1 R2 / (R1 + R2), E* of both materials; ``ball_plate_law``), the
+  (from the contact table, ``tailbeam.physics.contacts``: ball-ball R = R1 R2 / (R1 + R2),
+  E* of both materials; ball-plate), the
   pair geometry of ``tailbeam.physics.pair`` and the plate frame of
   ``tailbeam.physics.incline`` (gravity g (sin theta, 0, -cos theta));
 * events at every kink: contact start and end of every pair, penetration = d (STEP kink,
@@ -56,12 +57,11 @@ from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.contact_law import (
     HERTZ_EXPONENT,
     ImpactLaw,
-    ball_ball_law,
-    ball_plate_law,
     clamp_indicator,
     elastic_energy,
     impact_force_in_region,
 )
+from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES, InclinedPlate
 from tailbeam.physics.pair import pair_kinematics, plate_foot
@@ -159,6 +159,7 @@ def simulate_stream_reference(
     release_times=None,
     progress=None,
     plate: ReferencePlate | None = None,
+    contacts=None,
 ) -> StreamReferenceResult:
     """Integrate ``balls`` (``tailbeam.Ball``, positions and velocities in the plate frame)
     on ``incline`` for ``duration`` s; see the module docstring.
@@ -170,12 +171,13 @@ def simulate_stream_reference(
     its given position and velocity (event ``release``; the energy series jumps there).
     progress: optional callable, called with the time (s) reached after every accepted step.
     plate: a ``ReferencePlate`` (the modal plate, two-way,
-    ``tailbeam.solvers.stream.reference_plate``) or None (the rigid plate).
+    ``tailbeam.solvers.stream.reference_plate``) or None (the rigid plate). contacts: the
+    balls' ``ContactTable`` (its settings then replace the IMPACT parameters given here).
     """
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-3:
         raise InputError("rtol", f"must lie in [1e-14, 1e-3], got {rtol!r}")
-    options = dict(exponent=exponent, damping=damping, penetration=penetration, clamp=clamp)
+    options = LawOptions(exponent, damping, penetration, clamp) if contacts is None else contacts
     balls = list(balls)
     release = _release_times(release_times, len(balls))
     if plate is not None:
@@ -196,7 +198,7 @@ class _Reference:
         self.balls, self.incline, self.rtol, self.max_steps = balls, incline, rtol, max_steps
         self.g = incline.gravity_vector
         self.mass = np.array([b.mass for b in balls])
-        self.options = options
+        self.contacts = contact_table(balls, options, incline.plate.material)
         self.active = [i for i in range(len(balls)) if release[i] <= 0.0]
         self.waiting = sorted((float(release[i]), i) for i in range(len(balls)) if release[i] > 0)
         self.pairs = {}
@@ -658,13 +660,13 @@ class _Reference:
     def add_pairs(self, i):
         """Create the pairs of ball i with the plate and with every other active ball."""
         a, made = self.balls[i], []
-        law = ball_plate_law(a.material, a.radius, self.incline.plate.material, **self.options)
+        law = self.contacts.law(i, PLATE)
         made.append(self.pairs.setdefault((i, -1), _Pair(i, -1, law, a.radius)))
         for j in self.active:
             if j != i:
                 lo, hi = min(i, j), max(i, j)
                 b, c = self.balls[lo], self.balls[hi]
-                law = ball_ball_law(b.material, b.radius, c.material, c.radius, **self.options)
+                law = self.contacts.law(lo, hi)
                 pair = _Pair(lo, hi, law, b.radius + c.radius)
                 made.append(self.pairs.setdefault((lo, hi), pair))
         return made
