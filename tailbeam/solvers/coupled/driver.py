@@ -39,7 +39,7 @@ class CoupledRun:
 
     def __init__(self, balls, basis, contacts, duration, *, sensors, zeta, residual_flexibility,
                  steps_per_contact, rest_speed, rest_contact_factor, gravity):  # fmt: skip
-        self.balls, self.contacts, self.basis, self.duration = balls, contacts, basis, duration
+        self.balls, self.table, self.basis, self.duration = balls, contacts, basis, duration
         self.sensors, self.zeta, self.gravity = tuple(sensors), zeta, gravity
         self.residual_flexibility = residual_flexibility
         self.steps_per_contact, self.rest_speed = steps_per_contact, rest_speed
@@ -251,7 +251,7 @@ class CoupledRun:
         mg = self.balls[b].mass * self.gravity
         w = float(self.phi[b] @ self.q)
         self.mode[b] = S.REST
-        self.z[b] = self.radius[b] - self.contacts.law(b, PLATE).static_penetration(mg) + w
+        self.z[b] = self.radius[b] - self.table.law(b, PLATE).static_penetration(mg) + w
         self.vz[b] = 0.0
         self.F[b] = mg
         self.cur[:, b] = 0.0
@@ -273,7 +273,7 @@ class CoupledRun:
         n = self.nbuf
         return CoupledResult(
             balls=self.balls,
-            laws=self.contacts.plate_laws(),
+            laws=self.table.plate_laws(),
             basis=self.basis,
             duration=self.duration,
             gravity=self.gravity,

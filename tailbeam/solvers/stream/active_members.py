@@ -31,7 +31,7 @@ class ActiveMembers:
     """Members (ball numbers of ``balls``: a ``stream_state.Balls``) and their pairs."""
 
     def __init__(self, balls, rtol, settle_energy, plate=None, dead_loads=None):
-        self.balls, self.rtol = balls, rtol  # balls.contacts: the laws of the pairs
+        self.balls, self.rtol = balls, rtol  # balls.table: the laws of the pairs
         self.plate = plate  # a StreamPlate (two-way modal plate) or None (rigid)
         self.dead_loads = dead_loads  # () -> (xy (p, 2), weights (p,)) of resting non-members
         self.now = 0.0  # the driver's time (s), where a rebuilt set starts
@@ -91,7 +91,7 @@ class ActiveMembers:
         ]
         local = {i: q for q, i in enumerate(m)}
         pairs = [(local[i], -1 if j < 0 else local[j]) for i, j in self.keys]
-        laws = [b.contacts.law(i, PLATE if j < 0 else j) for i, j in self.keys]
+        laws = [b.table.law(i, PLATE if j < 0 else j) for i, j in self.keys]
         settle = [0.0 if i in self.quiet else self.settle_energy(i) for i in m]
         self._count()
         self.set = ActiveSet(

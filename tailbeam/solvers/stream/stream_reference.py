@@ -198,7 +198,7 @@ class _Reference:
         self.balls, self.incline, self.rtol, self.max_steps = balls, incline, rtol, max_steps
         self.g = incline.gravity_vector
         self.mass = np.array([b.mass for b in balls])
-        self.contacts = contact_table(balls, options, incline.plate.material)
+        self.table = contact_table(balls, options, incline.plate.material)  # the pairs' laws
         self.active = [i for i in range(len(balls)) if release[i] <= 0.0]
         self.waiting = sorted((float(release[i]), i) for i in range(len(balls)) if release[i] > 0)
         self.pairs = {}
@@ -660,13 +660,13 @@ class _Reference:
     def add_pairs(self, i):
         """Create the pairs of ball i with the plate and with every other active ball."""
         a, made = self.balls[i], []
-        law = self.contacts.law(i, PLATE)
+        law = self.table.law(i, PLATE)
         made.append(self.pairs.setdefault((i, -1), _Pair(i, -1, law, a.radius)))
         for j in self.active:
             if j != i:
                 lo, hi = min(i, j), max(i, j)
                 b, c = self.balls[lo], self.balls[hi]
-                law = self.contacts.law(lo, hi)
+                law = self.table.law(lo, hi)
                 pair = _Pair(lo, hi, law, b.radius + c.radius)
                 made.append(self.pairs.setdefault((lo, hi), pair))
         return made

@@ -36,7 +36,7 @@ class Balls:
         self.g = np.asarray(incline.gravity_vector, dtype=float)
         self.g_slide = np.array([self.g[0], self.g[1], 0.0])
         self.half = incline.half_sizes
-        self.contacts = contacts  # the ContactTable of the particles (tailbeam.physics.contacts)
+        self.table = contacts  # the ContactTable of the particles (tailbeam.physics.contacts)
         weight_n = self.mass * max(-self.g[2], 0.0)
         self.static_pen = np.array(
             [self.plate_law(i).static_penetration(w) for i, w in enumerate(weight_n)]
@@ -45,7 +45,7 @@ class Balls:
 
     def plate_law(self, i: int):
         """The ball-plate law of ball i (its row in the contact table)."""
-        return self.contacts.law(i, PLATE)
+        return self.table.law(i, PLATE)
 
     def accel(self, i: int) -> np.ndarray:
         return self.g_slide if self.status[i] == SLIDE else self.g
