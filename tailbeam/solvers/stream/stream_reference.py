@@ -65,7 +65,7 @@ from tailbeam.physics.contact_law import (
 from tailbeam.physics.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES, InclinedPlate
 from tailbeam.physics.pair import pair_kinematics, plate_foot
-from tailbeam.solvers.records import PLATE, ContactRecord, Event, EventKind, LeaveEvent
+from tailbeam.solvers.records import PLATE, Event, EventKind, Impact, LeaveEvent
 from tailbeam.solvers.stream.reference_plate import ReferencePlate
 from tailbeam.solvers.stream.step_events import (
     STEP_POINTS,
@@ -125,7 +125,7 @@ class _Laws:
 
 @dataclass
 class StreamReferenceResult:
-    """Contacts (one ``ContactRecord`` per ball per contact), leave events, the event log
+    """Contacts (one ``Impact`` per ball per contact), leave events, the event log
     (``Event`` records in time order), and per accepted step: times, total energy (J) and states
     (names of the balls present, positions (n, 3) m, velocities (n, 3) m/s)."""
 
@@ -597,13 +597,13 @@ class _Reference:
         point = x_i - n * (self.balls[p.i].radius - 0.5 * max(kin.penetration[0], 0.0))
         rate = float(kin.rate[0]) if p.j >= 0 or self.plate is None else float(-v[li] @ n)
         p.records = [
-            ContactRecord(self.balls[p.i].name, self.partner_name(p), t, point[0], point[1],
-                          float(-v[li] @ n), rate)
+            Impact(ball=self.balls[p.i].name, partner=self.partner_name(p), t_start=t,
+                   x=point[0], y=point[1], v_in=float(-v[li] @ n), approach_in=rate)
         ]  # fmt: skip
         if p.j >= 0:
             p.records.append(
-                ContactRecord(self.balls[p.j].name, self.balls[p.i].name, t, point[0], point[1],
-                              float(v[lj] @ n), rate)
+                Impact(ball=self.balls[p.j].name, partner=self.balls[p.i].name, t_start=t,
+                       x=point[0], y=point[1], v_in=float(v[lj] @ n), approach_in=rate)
             )  # fmt: skip
         self.contacts.extend(p.records)
         self.log(t, EventKind.CONTACT_START, p)
