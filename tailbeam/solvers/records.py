@@ -132,8 +132,10 @@ class Impact:
 
     @property
     def restitution(self) -> float:
-        """approach_out / approach_in (v_out / v_in for a plate contact; 1), nan unless the
-        contact ended by separation or rest and approach_in > 0."""
+        """Coefficient of restitution (dimensionless): approach_out / approach_in (v_out / v_in
+        for a plate contact), nan unless the contact ended by separation or rest and
+        approach_in > 0 (single-ball solvers: 0.0 for a ball declared at rest in contact,
+        where v_out = 0)."""
         if self.end in ("separated", "rest") and self.approach_in > 0.0:
             return self.approach_out / self.approach_in
         return math.nan
@@ -148,26 +150,37 @@ class Impact:
         """t_end - t_start (s)."""
         return self.t_end - self.t_start
 
+    @classmethod
+    def single_ball(cls, ball, *, t_start, v_in, v_out, at_rest, **other) -> "Impact":
+        """A single-ball solver's contact with the plate (rigid, coupled, FE reference).
+
+        Parameters
+        ----------
+        ball : Ball or Pair
+            The ball: ``name``, initial ``position`` (m) and ``velocity`` (m/s); its lateral
+            motion is uniform, so x, y = position[:2] + velocity[:2] t_start.
+        t_start, v_in, v_out : float
+            As the fields (s, m/s, m/s); the approach speeds are the ball's (v_in, v_out).
+        at_rest : bool
+            The ball was declared at rest in this contact (``end`` = ``rest``); otherwise
+            ``end`` is ``duration`` if v_out is nan (the run ended during it), else
+            ``separated``.
+        **other
+            The remaining fields (index, t_end, peak_force, t_peak, max_penetration,
+            next_apex_height).
+        """
+        x = ball.position[0] + ball.velocity[0] * t_start
+        y = ball.position[1] + ball.velocity[1] * t_start
+        end = "rest" if at_rest else ("duration" if math.isnan(v_out) else "separated")
+        return cls(ball=ball.name, partner=PLATE, t_start=t_start, x=x, y=y, v_in=v_in,
+                   approach_in=v_in, v_out=v_out, approach_out=v_out, end=end, **other)  # fmt: skip
+
     def as_dict(self) -> dict:
         """Every field, then ``restitution`` and ``ends_at_rest``."""
         out = {f.name: getattr(self, f.name) for f in fields(self)}
         out["restitution"] = self.restitution
         out["ends_at_rest"] = self.ends_at_rest
         return out
-
-
-def plate_contact_end(at_rest: bool, v_out: float) -> str:
-    """``end`` of a single-ball solver's plate contact: ``rest`` if the ball was declared at
-    rest, ``duration`` if the run ended during it (v_out nan), else ``separated``."""
-    if at_rest:
-        return "rest"
-    return "duration" if math.isnan(v_out) else "separated"
-
-
-def lateral_point(ball, t: float) -> tuple:
-    """(x, y) in m of ``ball``'s centre at time ``t`` (s) under uniform lateral motion from
-    its initial ``position`` (m) at ``velocity`` (m/s): a single-ball solver's contact point."""
-    return (ball.position[0] + ball.velocity[0] * t, ball.position[1] + ball.velocity[1] * t)
 
 
 ContactRecord = Impact  # the stream solvers' former name (same class)

@@ -253,21 +253,17 @@ def _impacts(ball, t, hist, vz, dt):
         seg = slice(k0, k1 + 2)
         peak, t_peak = _parabola_peak(t[seg], force[seg], int(np.argmax(force[seg])))
         out.append(
-            Impact(
-                ball=ball.name,
+            Impact.single_ball(
+                ball,
                 index=len(out) + 1,
                 t_start=float(t[k0] + s0 * dt),
-                x=float(ball.position[0]),
-                y=float(ball.position[1]),
                 t_end=float(t[k1] + s1 * dt),
                 v_in=v_in,
-                approach_in=v_in,
                 v_out=v_out,
-                approach_out=v_out,
                 peak_force=peak,
                 t_peak=t_peak,
                 max_penetration=_parabola_peak(t[seg], delta[seg], int(np.argmax(delta[seg])))[0],
-                end="separated",
+                at_rest=False,
             )
         )
     return out

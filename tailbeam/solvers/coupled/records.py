@@ -7,7 +7,7 @@ import weakref
 import numpy as np
 
 from tailbeam.modal import ModalBasis
-from tailbeam.solvers.records import Impact, lateral_point, plate_contact_end
+from tailbeam.solvers.records import Impact
 
 _COMPLIANCE_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
@@ -56,22 +56,16 @@ def close_contact(info, b, ball, t_end, v_out, bufs, nbuf, radius, gravity, *, a
     apex = math.nan
     if not at_rest and math.isfinite(v_out) and v_out > 0:
         apex = float(z) - radius + (v_out**2 / (2 * gravity) if gravity > 0 else math.inf)
-    x, y = lateral_point(ball, float(info["t_start"]))
-    v_out = 0.0 if at_rest else v_out
-    return Impact(
-        ball=ball.name,
+    return Impact.single_ball(
+        ball,
         index=info["index"],
         t_start=float(info["t_start"]),
-        x=x,
-        y=y,
         t_end=float(t_end),
         v_in=v_in,
-        approach_in=v_in,
-        v_out=v_out,
-        approach_out=v_out,
+        v_out=0.0 if at_rest else v_out,
         peak_force=peak,
         t_peak=t_peak,
         max_penetration=float(np.max(ds)) if len(ds) else math.nan,
         next_apex_height=apex,
-        end=plate_contact_end(at_rest, v_out),
+        at_rest=bool(at_rest),
     )

@@ -20,14 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tailbeam.errors import WorkLimitError
-from tailbeam.solvers.records import (
-    PLATE,
-    Event,
-    EventKind,
-    Impact,
-    lateral_point,
-    plate_contact_end,
-)
+from tailbeam.solvers.records import PLATE, Event, EventKind, Impact
 from tailbeam.solvers.rigid.model import Pair, time_to_contact
 from tailbeam.solvers.rigid.result import RigidResult
 from tailbeam.solvers.rigid.trajectory import TrajectoryBuilder
@@ -145,24 +138,19 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
     at_rest = out.status == "rest" or (out.status == "separated" and out.v_out < p.rest_speed)
     v_out = {"separated": out.v_out, "rest": 0.0}.get(out.status, math.nan)
     apex = v_out**2 / (2.0 * p.gravity) if p.gravity > 0.0 and out.status == "separated" else None
-    x, y = lateral_point(p, tc)
     st.impacts.append(
-        Impact(
-            ball=p.name,
+        Impact.single_ball(
+            p,
             index=index,
             t_start=tc,
-            x=x,
-            y=y,
             t_end=t_end,
             v_in=v_in,
-            approach_in=v_in,
             v_out=v_out,
-            approach_out=v_out,
             peak_force=out.peak_force,
             t_peak=tc + out.tau_peak,
             max_penetration=out.max_penetration,
             next_apex_height=math.nan if (apex is None or at_rest) else apex,
-            end=plate_contact_end(at_rest, v_out),
+            at_rest=at_rest,
         )
     )
     if at_rest:
@@ -178,12 +166,11 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
 
 def _rest(st, tc, index, v_in, v_out, t_end):
     p = st.pair
-    x, y = lateral_point(p, tc)
     st.impacts.append(
-        Impact(
-            ball=p.name, index=index, t_start=tc, x=x, y=y, t_end=t_end, v_in=v_in,
-            approach_in=v_in, v_out=v_out, approach_out=v_out, peak_force=p.mass * p.gravity,
-            t_peak=tc, max_penetration=p.delta_static, end="rest",
+        Impact.single_ball(
+            p, index=index, t_start=tc, t_end=t_end, v_in=v_in, v_out=v_out,
+            peak_force=p.mass * p.gravity, t_peak=tc, max_penetration=p.delta_static,
+            at_rest=True,
         )
     )  # fmt: skip
     st.events.append(Event(t_end, p.name, EventKind.REST, PLATE))
