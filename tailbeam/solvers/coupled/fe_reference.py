@@ -15,8 +15,9 @@ bracketed and solved by Brent's method.
 
 Contact start and end are located inside their step (cubic Hermite interpolation of the
 penetration from its values and rates at both step ends); the ball's speed there gives the
-restitution. The peak force and the maximum penetration are refined by a parabola through the
-three nodes around the largest one. Nothing is shared with the modal solver
+restitution. The peak force (and its time) and the maximum penetration are refined by a
+parabola through the three nodes around the largest one; the contacts are ``Impact`` records
+(``tailbeam.solvers.records``, as every solver's). Nothing is shared with the modal solver
 (``tailbeam.solvers.coupled.solver``) but the mesh, the element assembly and the contact law's
 formula.
 
