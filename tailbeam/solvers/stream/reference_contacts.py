@@ -5,7 +5,7 @@
 
 Every pair is a ``_Pair`` (ball-ball or ball-plate: its law, its region flags, its open
 records); an event found by ``reference_events`` is applied here (``apply``): a contact
-starts or ends (one ``ContactRecord`` per ball), a region flag flips, or a ball leaves over
+starts or ends (one ``Impact`` per ball), a region flag flips, or a ball leaves over
 an edge and is dropped from the state.
 """
 
@@ -22,7 +22,7 @@ from tailbeam.physics.contact_law import (
 )
 from tailbeam.physics.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES
-from tailbeam.solvers.records import PLATE, ContactRecord, Event, EventKind, LeaveEvent
+from tailbeam.solvers.records import PLATE, Event, EventKind, Impact, LeaveEvent
 
 
 @dataclass
@@ -101,13 +101,13 @@ class ReferenceContacts:
         point = x_i - n * (self.balls[p.i].radius - 0.5 * max(kin.penetration[0], 0.0))
         rate = float(kin.rate[0]) if p.j >= 0 or self.plate is None else float(-v[li] @ n)
         p.records = [
-            ContactRecord(self.balls[p.i].name, self.partner_name(p), t, point[0], point[1],
-                          float(-v[li] @ n), rate)
+            Impact(ball=self.balls[p.i].name, partner=self.partner_name(p), t_start=t,
+                   x=point[0], y=point[1], v_in=float(-v[li] @ n), approach_in=rate)
         ]  # fmt: skip
         if p.j >= 0:
             p.records.append(
-                ContactRecord(self.balls[p.j].name, self.balls[p.i].name, t, point[0], point[1],
-                              float(v[lj] @ n), rate)
+                Impact(ball=self.balls[p.j].name, partner=self.balls[p.i].name, t_start=t,
+                       x=point[0], y=point[1], v_in=float(v[lj] @ n), approach_in=rate)
             )  # fmt: skip
         self.contacts.extend(p.records)
         self.log(t, EventKind.CONTACT_START, p)

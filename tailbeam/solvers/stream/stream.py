@@ -17,7 +17,7 @@ dropped: the energy removed is counted in ``stats["rest_energy_removed"]``). A s
 something approaches joins the active set again, at its static state (an equilibrium of the
 full model, so nothing jumps).
 
-Contacts are recorded as ``ContactRecord`` (one per ball per contact; ``end`` is
+Contacts are recorded as ``Impact`` (one per ball per contact; ``end`` is
 ``separated``, ``rest``, ``left`` or ``duration``); the plate's contact forces are kept as
 piecewise-linear histories at their contact points and sliders as dead loads, for the modal
 plate's sensors.
@@ -194,7 +194,7 @@ class _Stream(StreamHeap, StreamSetEvents, StreamMembership, StreamRecords):
         self.epoch_end, self.set_end = 0.0, 0.0
         self.core = set()
         self.contacts, self.leaves, self.events = [], [], []
-        self.open = {}  # (i, j) -> [ContactRecord(s)] of the contacts in progress
+        self.open = {}  # (i, j) -> [Impact(s)] of the contacts in progress
         self.limit = {}  # i -> time at which ball i's plate contact is declared at rest
         self.loads, self.dead_loads = [], []
         self.stats = dict.fromkeys(

@@ -62,7 +62,7 @@ MODAL_STEPS_PER_PERIOD = 5  # a lower bound of the steps per period of the top m
 
 @dataclass
 class StreamReferenceResult:
-    """Contacts (one ``ContactRecord`` per ball per contact), leave events, the event log
+    """Contacts (one ``Impact`` per ball per contact), leave events, the event log
     (``Event`` records in time order), and per accepted step: times, total energy (J) and states
     (names of the balls present, positions (n, 3) m, velocities (n, 3) m/s)."""
 
