@@ -11,8 +11,11 @@ dt 2e-7 s, 0.4 ms), the stream solver and the stream reference (the ten-ball sce
 15 deg plate, c = 2000 N s/m, d = 2e-5 m: ball-ball contacts, clamp and STEP kinks), the stream
 solver on the modal plate. Prints per solver "bit-identical" or the largest difference of
 any number relative to the largest magnitude of its column (and the column), the numeric
-columns whose length changed (an adaptive reference taking other steps), and the non-numeric
-columns (names, event kinds, ends) that differ. Events are compared by field (t, ball, kind,
+columns whose length changed (an adaptive reference taking other steps), the non-numeric
+columns (names, event kinds, ends) that differ, and the columns only this tree has (a record
+extended: compared are the base's columns, each of which must still exist). Records are
+flattened by ``as_dict()`` when they have it (so derived values such as ``restitution``
+are compared), else by their dataclass fields. Events are compared by field (t, ball, kind,
 partner), whichever tuple order the revision wrote them in (``_events``). ``--quick`` drops
 the FE reference and the stream reference (the slow ones). Exit code 1 if a non-numeric
 column differs; how large a numeric difference is acceptable is the reader's call: the
@@ -40,7 +43,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _columns(obj, prefix, out):
     """Flatten records, tuples, dicts and arrays into named columns (lists of scalars)."""
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+    if hasattr(obj, "as_dict") and not isinstance(obj, type):
+        obj = obj.as_dict()  # a record's fields and its derived values (restitution, ...)
+    elif dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         obj = {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
     if isinstance(obj, dict):
         for key, value in obj.items():
@@ -164,8 +169,10 @@ def _run_in(tree, out_path, cache, quick):
 
 def compare(a: dict, b: dict) -> tuple:
     """(bit-identical, differing non-numeric columns, numeric columns of another length,
-    largest relative difference and its column) of one solver's flattened results."""
-    text, lengths = sorted(a.keys() ^ b.keys()), []
+    largest relative difference and its column, columns only the new revision has) of one
+    solver's flattened results (a: base, b: new). A column the new revision lost counts as
+    differing; one it added (a record extended) is listed, the common ones are compared."""
+    text, lengths, added = sorted(a.keys() - b.keys()), [], sorted(b.keys() - a.keys())
     worst, where, identical = 0.0, "", True
     for key in sorted(a.keys() & b.keys()):
         x, y = a[key], b[key]
@@ -183,7 +190,7 @@ def compare(a: dict, b: dict) -> tuple:
         diff = np.abs(x - y)[~(np.isnan(x) & np.isnan(y))]
         if diff.size and scale > 0.0 and float(np.max(diff)) / scale > worst:
             worst, where = float(np.max(diff)) / scale, key
-    return identical and not text and not lengths, text, lengths, worst, where
+    return identical and not text and not lengths, text, lengths, worst, where, added
 
 
 def main(base, quick=False, keep=None):
@@ -198,13 +205,14 @@ def main(base, quick=False, keep=None):
         b = pickle.loads((store / "new.pkl").read_bytes())
     ok = True
     for name in a:
-        identical, text, lengths, worst, where = compare(a[name], b[name])
+        identical, text, lengths, worst, where, added = compare(a[name], b[name])
         ok &= not text
         n = sum(len(v) for v in a[name].values())
         what = (
             "bit-identical" if identical else f"largest relative difference {worst:.1e} ({where})"
         )
         notes = [f"DIFFERENT: {', '.join(text)}"] * bool(text) + lengths
+        notes += [f"new columns: {', '.join(added)}"] * bool(added)
         print(f"{name}: {what} ({n} values)" + "".join(f"; {x}" for x in notes))
     return 0 if ok else 1
 

@@ -106,17 +106,19 @@ def check_outputs(scene) -> None:
             )
 
 
-def check_streams(scene) -> None:
+def check_streams(scene, engine=None) -> None:
     """Rules for a scene the stream solver runs (streams, an inclined plate or balls that may
-    touch): the particle count the solver accepts, from the expected count before the
-    particles are generated and the actual count after; then the contact rules for every
-    stream particle (``streams[i].height`` or ``.velocity``, whichever gives more speed).
-    WorkLimitError names the setting to change."""
-    if not scene.needs_stream_solver:
-        return
-    from tailbeam.solvers.stream.engine import stream_engine
+    touch; or any scene given the ``engine`` that will run it, a
+    ``tailbeam.solvers.stream.engine.StreamEngine``): the particle count the solver accepts,
+    from the expected count before the particles are generated and the actual count after;
+    then the contact rules for every stream particle (``streams[i].height`` or ``.velocity``,
+    whichever gives more speed). WorkLimitError names the setting to change."""
+    if engine is None:
+        if not scene.needs_stream_solver:
+            return
+        from tailbeam.solvers.stream.engine import stream_engine
 
-    engine = stream_engine()
+        engine = stream_engine()
     _check_particle_count(scene, engine, sum(scene.expected_particles()), "expects")
     _check_particle_count(scene, engine, len(scene.particles) - len(scene.balls), "has")
     streams = {s.name: i for i, s in enumerate(scene.streams, start=1)}

@@ -7,7 +7,7 @@ results are thin subclasses that add only what is theirs:
 - ``tailbeam.solvers.rigid.RigidResult`` (rigid plate, balls that cannot touch) and
   ``tailbeam.solvers.coupled.CoupledResult`` (modal plate; adds the modal replay ``modal_sample``,
   ``plate_sample``, the sensors), both through ``BallsResult`` (the single-ball solvers:
-  ``impacts`` as ``Impact`` records, ``sample(times)`` exact at any times, ``rest_time``);
+  ``sample(times)`` exact at any times, ``rest_time``);
 - ``tailbeam.solvers.stream.stream_result.StreamResult`` (streams, an inclined plate, balls that
   may touch; keeps its records only, so no ``sample``).
 
@@ -15,7 +15,8 @@ Common interface (every result):
 
 - ``status`` (0: reached the end), ``message``, ``stats`` (dict: the solver's work counts),
   ``info`` (dict: what was chosen automatically), ``duration`` (s), ``plate_model``;
-- ``impacts`` (the solver's contact records; ``len`` counts impacts.csv rows),
+- ``impacts`` (the solver's contact records, ``tailbeam.solvers.records.Impact``, the one
+  record of every solver; ``len`` counts impacts.csv rows),
   ``impacts_table()`` (impacts.csv as numpy columns, ``IMPACT_TABLE_COLUMNS``),
   ``particles_table()`` (particles.csv, ``PARTICLE_COLUMNS``: one row per ball, streams
   and ``[[balls]]`` alike), ``impacts_of(name)``, ``events_of(name, kind)``, ``leaves``;
@@ -50,7 +51,7 @@ import math
 import numpy as np
 
 from tailbeam.errors import InputError, require_positive
-from tailbeam.solvers.records import PLATE, ContactRecord, LeaveEvent
+from tailbeam.solvers.records import LeaveEvent
 
 # The single-ball solvers' impacts.csv columns (the contract's first twelve) and units.
 IMPACT_COLUMNS = (
@@ -86,7 +87,7 @@ class Result:
     A subclass provides ``duration`` (s), ``status``, ``message``, ``info``, ``impacts``,
     ``events`` (``tailbeam.solvers.records.Event`` records in time order), ``leaves`` and the
     two hooks ``particle_records()`` (every body as a ``tailbeam.streams.generator.Particle``)
-    and ``_impact_rows()`` ((twelve historical values, ``ContactRecord``) per impacts.csv row,
+    and ``_impact_rows()`` (the ``tailbeam.solvers.records.Impact`` of every impacts.csv row,
     in row order).
     """
 
@@ -103,11 +104,12 @@ class Result:
         """impacts.csv as columns: name -> numpy array, in ``IMPACT_TABLE_COLUMNS`` order."""
         by_name = {p.name: p for p in self.particle_records()}
         rows = []
-        for twelve, rec in self._impact_rows():
+        for rec in self._impact_rows():
             p = by_name[rec.ball]
             rows.append(
-                (*twelve, rec.partner, rec.x, rec.y, p.material.name, p.radius,
-                 p.label, p.stream, rec.end, rec.approach_in, rec.approach_out)
+                (*(getattr(rec, c) for c in IMPACT_COLUMNS), rec.partner, rec.x, rec.y,
+                 p.material.name, p.radius, p.label, p.stream, rec.end, rec.approach_in,
+                 rec.approach_out)
             )  # fmt: skip
         return columns(IMPACT_TABLE_COLUMNS, rows)
 
@@ -170,8 +172,8 @@ class Result:
 
 
 class BallsResult(Result):
-    """The single-ball solvers' common part (rigid and modal plate): ``impacts`` are
-    ``tailbeam.solvers.rigid.Impact`` records, ``events`` ``Event`` records (partner ``plate``),
+    """The single-ball solvers' common part (rigid and modal plate): ``impacts`` are ``Impact``
+    records (partner ``plate``, in time order), ``events`` ``Event`` records (partner ``plate``),
     the balls move laterally at their constant initial velocity. A subclass provides ``balls``,
     ``labels`` (one per ball; empty: ``tailbeam.scene.default_label``), ``_plate()`` (the
     ``tailbeam.physics.bodies.Plate``, or None when unknown) and ``nfev``, ``n_steps``."""
@@ -204,10 +206,7 @@ class BallsResult(Result):
         return sorted((e for e in out if e is not None), key=lambda e: e.time)
 
     def _impact_rows(self):
-        balls = {b.name: b for b in self.balls}
-        for imp in self.impacts:
-            twelve = tuple(getattr(imp, c) for c in IMPACT_COLUMNS)
-            yield twelve, _plate_record(imp, balls[imp.ball])
+        return self.impacts
 
     def _times(self, times, slack: float = 0.0) -> np.ndarray:
         """``times`` (s) as a 1-D float array, checked finite and within [0, duration]
@@ -218,22 +217,6 @@ class BallsResult(Result):
         if t.size and (t.min() < 0.0 or t.max() > self.duration * (1.0 + slack)):
             raise InputError("times", f"must lie within [0, duration = {self.duration!r}] s")
         return t
-
-
-def _plate_record(imp, ball) -> ContactRecord:
-    """The ``ContactRecord`` of a single-ball solver's ``Impact`` on the plate."""
-    x = ball.position[0] + ball.velocity[0] * imp.t_start
-    y = ball.position[1] + ball.velocity[1] * imp.t_start
-    if imp.ends_at_rest:
-        end = "rest"
-    elif math.isnan(imp.v_out):
-        end = "duration"
-    else:
-        end = "separated"
-    return ContactRecord(
-        imp.ball, PLATE, imp.t_start, x, y, imp.v_in, imp.v_in, imp.t_end, imp.v_out,
-        imp.v_out, imp.peak_force, imp.t_peak, imp.max_penetration, end,
-    )  # fmt: skip
 
 
 def _leave(ball, plate, duration):

@@ -1,16 +1,21 @@
 """``tailbeam.simulate(scene, **how)``: the one library call that runs a scene.
 
-What to simulate (a ``tailbeam.scene.Scene``) is positional; how (rtol, max_steps,
-progress) is keyword-only. It returns one result type, ``tailbeam.result.Result``, whichever
-solver the scene chooses:
+What to simulate (a ``tailbeam.scene.Scene``) is positional; how (the solver, rtol,
+max_steps, progress) is keyword-only. It returns one result type, ``tailbeam.result.Result``,
+whichever solver runs. The solver is a swappable part (``solver=``, ``SOLVERS``):
 
-- rigid plate, no streams, no inclination, no two balls that can touch (their horizontal
-  paths never come within the sum of the radii): ``tailbeam.solvers.rigid.simulate_rigid``, exact
-  per ball (its ``Result`` is a ``RigidResult``);
-- modal plate with balls only: the coupled modal solver
+- ``"single-ball"``: the exact per-ball solvers, for scenes without streams, without
+  inclination and without two balls that can touch (their horizontal paths never come within
+  the sum of the radii): on the rigid plate ``tailbeam.solvers.rigid.simulate_rigid`` (its
+  ``Result`` is a ``RigidResult``), on the modal plate the coupled modal solver
   (``tailbeam.solvers.coupled.simulate_scene_modal``, a ``CoupledResult``);
-- otherwise (streams, an inclined plate, balls that may touch): the stream solver of
-  ``tailbeam.solvers.stream.engine`` (a ``StreamResult``), on the rigid or the modal plate.
+- ``"stream"``: the fast stream solver (``tailbeam.solvers.stream.engine``, a
+  ``StreamResult``), on the rigid or the modal plate; it runs every scene;
+- ``"stream-reference"``: the slow independent reference of the stream solver (scipy DOP853,
+  every pair watched, at most ``REFERENCE_MAX_PARTICLES`` bodies), on the rigid plate;
+- ``"auto"`` (the default): ``"single-ball"`` where it can run, else ``"stream"``.
+
+Running one scene through two solvers is how a user checks one against the other.
 """
 
 import contextlib
@@ -20,15 +25,19 @@ from tailbeam.progress import note, quiet, task
 
 STREAM_MIN_BAND_HZ = 10_000.0  # modal band of a stream scene without sensors or plate.fmax
 MAX_STREAM_MEMORY = 2e9  # bytes the reference may keep (its step budget x state size)
+SOLVERS = ("auto", "single-ball", "stream", "stream-reference")
 
 
-def simulate(scene, *, rtol=None, max_steps=None, progress=True):
+def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
     """Simulate ``scene`` and return its result.
 
     Parameters
     ----------
     scene : tailbeam.scene.Scene
         What to simulate (e.g. from ``tailbeam.io.scene_file.load_scene``).
+    solver : str
+        Which solver runs it, one of ``SOLVERS`` (module docstring); ``"auto"`` by default.
+        The choice is in ``result.info["solver"]``.
     rtol : float, optional
         Relative tolerance of the solver (rigid: its default 1e-10; stream reference 1e-10).
     max_steps : int, optional
@@ -52,23 +61,55 @@ def simulate(scene, *, rtol=None, max_steps=None, progress=True):
     if not isinstance(scene, Scene):
         raise InputError("scene", f"must be a tailbeam.scene.Scene, got {type(scene).__name__}")
     how = {k: v for k, v in (("rtol", rtol), ("max_steps", max_steps)) if v is not None}
+    method = choose_solver(scene, solver)
     with contextlib.nullcontext() if progress else quiet():
-        if scene.needs_stream_solver:
-            from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene
+        if method == "single-ball":
+            result = _modal(scene, how) if scene.plate_model == "modal" else _rigid(scene, how)
+            result.labels = scene.labels  # the scene's coal / gangue labels of its balls
+        else:
+            result = _through_stream(scene, how, method == "stream-reference")
+    result.info["solver"] = method
+    return result
 
-            check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
-            if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
-                note("tail: quasi-static (the stream solver: contact points are not known in "
-                     "advance)")  # fmt: skip
-            band = stream_band(scene) if scene.plate_model == "modal" else None
-            plate = _stream_plate(scene, band) if band and band["two_way"] else None
-            result = _stream(scene, how, plate)
-            if band:
-                _modal_sensors(scene, result, band, plate)
-            return result
-        result = _modal(scene, how) if scene.plate_model == "modal" else _rigid(scene, how)
-        result.labels = scene.labels  # the scene's coal / gangue labels of its balls
-        return result
+
+def choose_solver(scene, solver: str = "auto", field: str = "solver") -> str:
+    """The solver that runs ``scene`` (one of ``SOLVERS`` but "auto"): ``solver`` itself,
+    checked against the scene before any work, or for "auto" the single-ball solvers where
+    they can run, else the stream solver. InputError naming ``field`` (the caller's name,
+    e.g. ``--solver``) for a solver that cannot run the scene."""
+    if solver not in SOLVERS:
+        raise InputError(field, f"must be one of {', '.join(SOLVERS)}; got {solver!r}")
+    if solver == "auto":
+        return "stream" if scene.needs_stream_solver else "single-ball"
+    if solver == "single-ball" and scene.needs_stream_solver:
+        raise InputError(
+            field,
+            f"'single-ball' cannot run this scene ({_why_stream(scene)}): streams, an inclined "
+            "plate and ball-ball contact need 'stream' or 'stream-reference'",
+        )
+    if solver == "stream-reference" and scene.plate_model != "rigid":
+        raise InputError(
+            field,
+            "'stream-reference' runs on the rigid plate (plate.model = \"rigid\"); its modal "
+            "plate (tailbeam.solvers.stream.reference_plate) has no residual flexibility or "
+            "sensors, and is used by the tests",
+        )
+    return solver
+
+
+def _through_stream(scene, how, reference: bool):
+    """``scene`` through the fast stream solver (or its reference), then its sensors."""
+    from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene
+
+    check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
+    if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
+        note("tail: quasi-static (the stream solver: contact points are not known in advance)")
+    band = stream_band(scene) if scene.plate_model == "modal" else None
+    plate = _stream_plate(scene, band) if band and band["two_way"] else None
+    result = _stream(scene, how, plate, reference)
+    if band:
+        _modal_sensors(scene, result, band, plate)
+    return result
 
 
 def _rigid(scene, how):
@@ -90,12 +131,12 @@ def _modal(scene, how):
     return simulate_scene_modal(scene)
 
 
-def _stream(scene, how, plate=None):
+def _stream(scene, how, plate=None, reference=False):
     from tailbeam.preflight import check_streams
-    from tailbeam.solvers.stream.engine import stream_engine
+    from tailbeam.solvers.stream.engine import reference_engine, stream_engine
 
-    check_streams(scene)  # (already done by load_scene; a Scene built in Python needs it)
-    engine = stream_engine()
+    engine = reference_engine() if reference else stream_engine()
+    check_streams(scene, engine)  # (load_scene checked for the fast solver; not Python scenes)
     particles = scene.particles
     rtol, max_steps = how.get("rtol", engine.rtol), how.get("max_steps", engine.max_steps)
     memory, worst = engine.estimate(len(particles), max_steps)
@@ -199,6 +240,8 @@ def _modal_sensors(scene, result, band, plate):
 
 
 def _why_stream(scene) -> str:
+    if not scene.needs_stream_solver:
+        return "solver requested"
     if scene.streams:
         return f"{len(scene.streams)} stream(s)"
     if scene.inclination != 0.0:

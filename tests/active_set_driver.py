@@ -1,5 +1,5 @@
 """A minimal driver for tests: every ball of a small scene in ONE active set, all pairs watched,
-restarted after every event; writes the same ContactRecord / LeaveEvent as the stream
+restarted after every event; writes the same Impact / LeaveEvent records as the stream
 reference (not a test module; the fast solver's real driver is
 tailbeam/solvers/stream/stream.py)."""
 
@@ -9,7 +9,7 @@ import numpy as np
 
 from tailbeam.physics.incline import EDGES
 from tailbeam.physics.pair import pair_kinematics, plate_foot
-from tailbeam.solvers.records import PLATE, ContactRecord, LeaveEvent
+from tailbeam.solvers.records import PLATE, Impact, LeaveEvent
 from tailbeam.solvers.stream.active_set import ActiveSet
 
 
@@ -59,11 +59,12 @@ class SceneRun:
         point = self.set.x[i] - n * (self.set.radius[i] - 0.5 * max(kin.penetration[0], 0.0))
         rate = float(kin.rate[0])
         partner = PLATE if j < 0 else self.names[j]
-        recs = [ContactRecord(self.names[i], partner, t, point[0], point[1],
-                              float(-self.set.v[i] @ n), rate)]  # fmt: skip
+        recs = [Impact(ball=self.names[i], partner=partner, t_start=t, x=point[0], y=point[1],
+                       v_in=float(-self.set.v[i] @ n), approach_in=rate)]  # fmt: skip
         if j >= 0:
-            recs.append(ContactRecord(self.names[j], self.names[i], t, point[0], point[1],
-                                      float(self.set.v[j] @ n), rate))  # fmt: skip
+            recs.append(Impact(ball=self.names[j], partner=self.names[i], t_start=t,
+                               x=point[0], y=point[1], v_in=float(self.set.v[j] @ n),
+                               approach_in=rate))  # fmt: skip
         self.contacts.extend(recs)
         self.open[p] = recs
 

@@ -201,26 +201,24 @@ def test_a_stream_result_keeps_no_states():
         stream.sample([0.0])
 
 
-def test_every_solver_records_the_one_event_record():
-    """Rigid, rigid reference, two-way coupled, one-way, stream and stream reference: their
-    ``events`` are ``Event`` records (the same fields, kinds from ``EventKind``) in time
-    order, with the partners the record documents. Independent truth: each ball's first
-    contact starts at the free-fall time sqrt(2 h / g) of its gap h (on the flexible plate
-    only the first ball's: the plate is at rest until then); "m" moves sideways at 1 m/s
-    from x = 0.25 m and passes the x+ edge at 0.05 s.
-    """
+TWO_GAPS = {"c": 0.02, "m": 0.01}  # drop gaps (m) of the two balls of ``every_solver``
+
+
+@pytest.fixture(scope="module")
+def every_solver():
+    """Rigid, rigid reference, two-way coupled, one-way, stream and stream reference on two
+    balls: "c" dropped from rest, "m" moving sideways at 1 m/s from x = 0.25 m (it passes
+    the x+ edge at 0.05 s). name -> result."""
     from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.bodies import Plate
     from tailbeam.physics.contact_law import ball_plate_law
     from tailbeam.physics.materials import CARBON_STEEL
     from tailbeam.solvers.coupled import simulate_coupled
     from tailbeam.solvers.coupled.oneway import simulate_one_way
-    from tailbeam.solvers.records import PLATE, Event, EventKind
     from tailbeam.solvers.rigid import simulate_rigid
     from tailbeam.solvers.rigid.reference import simulate_rigid_reference
     from tailbeam.solvers.stream.engine import run_reference
 
-    gaps = {"c": 0.02, "m": 0.01}
     two = (Ball("c", COAL, 0.03, (-0.1, 0.05, 0.05), (0.0, 0.0, 0.0)),
            Ball("m", COAL, 0.02, (0.25, 0.0, 0.03), (1.0, 0.0, 0.0)))  # fmt: skip
     scene, duration = Scene(two, duration=0.07), 0.07
@@ -228,7 +226,7 @@ def test_every_solver_records_the_one_event_record():
     basis = ssss_kirchhoff_basis(Plate(), 2000.0)
     stream_args = (scene.particles, scene.incline, duration)
     stream_kw = dict(laws=scene.contact, rtol=1e-10, max_steps=10**6)
-    results = {
+    return two, {
         "rigid": simulate_rigid(two, Plate(), laws, duration),
         "rigid reference": simulate_rigid_reference(two, Plate(), laws, duration),
         "coupled two-way": simulate_coupled(two, basis, laws, duration),
@@ -236,6 +234,20 @@ def test_every_solver_records_the_one_event_record():
         "stream": stream_engine().run(*stream_args, **stream_kw),
         "stream reference": run_reference(*stream_args, **stream_kw),
     }
+
+
+def test_every_solver_records_the_one_event_record(every_solver):
+    """Rigid, rigid reference, two-way coupled, one-way, stream and stream reference: their
+    ``events`` are ``Event`` records (the same fields, kinds from ``EventKind``) in time
+    order, with the partners the record documents. Independent truth: each ball's first
+    contact starts at the free-fall time sqrt(2 h / g) of its gap h (on the flexible plate
+    only the first ball's: the plate is at rest until then); "m" moves sideways at 1 m/s
+    from x = 0.25 m and passes the x+ edge at 0.05 s.
+    """
+    from tailbeam.solvers.records import PLATE, Event, EventKind
+
+    gaps = TWO_GAPS
+    _, results = every_solver
     for solver, result in results.items():
         events = result.events
         assert events and all(type(e) is Event for e in events), solver
@@ -256,6 +268,64 @@ def test_every_solver_records_the_one_event_record():
     leaves = [e for e in results["stream"].events if e.kind == EventKind.LEAVE]
     assert [(e.ball, e.partner) for e in leaves] == [("m", "x+")]
     assert leaves[0].t == pytest.approx(0.05, rel=1e-9)
+
+
+SINGLE_BALL = ("rigid", "rigid reference", "coupled two-way", "one-way")
+
+
+def test_every_solver_records_the_one_impact_record(every_solver):
+    """Every solver's ``impacts`` are ``tailbeam.solvers.records.Impact`` records (one class;
+    the old names are aliases of it), numbered 1, 2, ... per ball in time order. Independent
+    truth: the lateral motion is uniform until a ball touches anything, so a single-ball
+    solver's x, y (the ball centre's at t_start) are x0 + vx t_start, y0 + vy t_start for
+    every contact, and so is every solver's first contact point of each ball (the contact
+    point is under the centre on the horizontal plate)."""
+    from tailbeam.solvers.coupled.fe_reference import FEImpact
+    from tailbeam.solvers.records import PLATE, ContactRecord, Impact
+    from tailbeam.solvers.rigid import Impact as RigidImpact
+    from tailbeam.solvers.rigid.result import Impact as RigidResultImpact
+
+    assert Impact is ContactRecord is FEImpact is RigidImpact is RigidResultImpact
+    two, results = every_solver
+    for solver, result in results.items():
+        assert result.impacts and all(type(i) is Impact for i in result.impacts), solver
+        for b in two:
+            mine = sorted(result.impacts_of(b.name), key=lambda i: i.t_start)
+            assert [i.index for i in mine] == list(range(1, len(mine) + 1)), (solver, b.name)
+            for imp in mine if solver in SINGLE_BALL else mine[:1]:
+                assert imp.partner == PLATE, (solver, imp)
+                t = imp.t_start
+                assert imp.x == pytest.approx(b.position[0] + b.velocity[0] * t, abs=1e-12)
+                assert imp.y == pytest.approx(b.position[1] + b.velocity[1] * t, abs=1e-12)
+
+
+def test_the_fe_reference_records_the_one_impact_record():
+    """The full-FE reference (tailbeam.solvers.coupled.fe_reference) writes ``Impact`` too.
+    Independent truth: until the touch the plate is at rest and the ball falls freely, so
+    the touch is at the root of r + gap - (v t + g t^2 / 2) = r (Newmark is exact for
+    constant acceleration; the located start within 1e-9 relative), at the ball's x, y."""
+    from tailbeam.physics.bodies import Plate
+    from tailbeam.physics.contact_law import ball_plate_law
+    from tailbeam.physics.materials import CARBON_STEEL
+    from tailbeam.plate import assemble_plate
+    from tailbeam.solvers.coupled.fe_reference import fe_reference
+    from tailbeam.solvers.records import PLATE, Impact
+
+    gap, speed = 1e-4, 2.0
+    ball = Ball("s", SANDSTONE, 0.03, (0.07, -0.05, 0.03 + gap), (0.0, 0.0, -speed))
+    law = ball_plate_law(SANDSTONE, 0.03, CARBON_STEEL, damping=800.0)
+    model = assemble_plate(Plate(), "SSSS", theory="kirchhoff", divisions=4)
+    ref = fe_reference(model, ball, law, 4e-4, dt=1e-6)
+    (imp,) = ref.impacts
+    assert type(imp) is Impact
+    assert (imp.ball, imp.partner, imp.index, imp.end) == ("s", PLATE, 1, "separated")
+    t_touch = (-speed + math.sqrt(speed**2 + 2.0 * G * gap)) / G
+    assert imp.t_start == pytest.approx(t_touch, rel=1e-9)
+    # v_in is interpolated over the step in which the force starts: measured 3.6e-9 off
+    assert imp.v_in == pytest.approx(speed + G * t_touch, rel=1e-7)
+    assert (imp.x, imp.y) == (0.07, -0.05)
+    assert imp.t_start < imp.t_peak < imp.t_end
+    assert imp.restitution == imp.v_out / imp.v_in and imp.duration == imp.t_end - imp.t_start
 
 
 def test_ball_ball_events_name_the_partner():

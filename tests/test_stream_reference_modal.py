@@ -25,7 +25,7 @@ from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Plate
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import CARBON_STEEL
-from tailbeam.solvers.stream import active_members, stream
+from tailbeam.solvers.stream import active_members, stream, stream_membership
 from tailbeam.solvers.stream.reference_plate import ReferencePlate
 from tailbeam.solvers.stream.stream_plate import StreamPlate
 from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
@@ -103,7 +103,7 @@ def _fast(scene, basis, law, travel=None, monkeypatch=None):
     """The fast solver on ``scene`` (optionally with its shape refresh distances set to
     ``travel``, test-only)."""
     if travel is not None:
-        monkeypatch.setattr(stream, "SHAPE_TRAVEL", travel)
+        monkeypatch.setattr(stream_membership, "SHAPE_TRAVEL", travel)
         monkeypatch.setattr(active_members, "SHAPE_REUSE", travel)
     balls, incline = scene
     plate = StreamPlate(basis, np.full(basis.n_modes, ZETA), residual_flexibility=False)

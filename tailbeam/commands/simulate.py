@@ -1,4 +1,7 @@
-"""`tailbeam simulate SCENE.toml [--out DIR]`: simulate a scene file and write its results.
+"""`tailbeam simulate SCENE.toml [--out DIR] [--solver NAME]`: simulate a scene, write results.
+
+--solver chooses the solver (``tailbeam.simulation.SOLVERS``; default auto), so one scene can
+be run through two solvers and their impacts.csv compared.
 
 Writes impacts.csv (every column of ``Result.impacts_table``), particles.csv, impacts.json
 and manifest.json into DIR, for every scene (tailbeam.result); timeseries.csv (uniform grid)
@@ -22,13 +25,21 @@ from tailbeam.progress import task
 def add_arguments(parser):
     parser.add_argument("scene", help="scene file (TOML); keys in docs/scene-files.md")
     parser.add_argument("--out", default="out/simulate", help="output directory")
+    parser.add_argument(
+        "--solver",
+        default="auto",
+        metavar="NAME",
+        help="auto (default: the exact single-ball solvers where they can run, else the "
+        "stream solver), single-ball, stream or stream-reference (the slow independent "
+        "reference, rigid plate, <= 20 bodies): run one scene through two to compare them",
+    )
 
 
-def solve(scene):
-    """Run the scene's solver (``tailbeam.simulate`` chooses it from the scene)."""
+def solve(scene, solver="auto"):
+    """Run ``scene`` with ``solver`` (``tailbeam.simulate``; "auto" chooses from the scene)."""
     from tailbeam import simulate
 
-    return simulate(scene)
+    return simulate(scene, solver=solver)
 
 
 def write_results(out_dir, scene, result) -> list:
@@ -81,14 +92,16 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
 
 def run(args) -> int:
     from tailbeam.io.scene_file import load_scene
+    from tailbeam.simulation import choose_solver
 
     check_output_dir(args.out)
     scene = load_scene(args.scene)
-    if scene.needs_stream_solver:
+    solver = choose_solver(scene, args.solver, "--solver")
+    if solver == "stream":
         announce_first_compile("stream")
-    else:
+    elif solver == "single-ball":
         announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
-    result = solve(scene)
+    result = solve(scene, solver)
     with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:
         files = write_results(tmp, scene, result)
     n = len(result.impacts)

@@ -4,7 +4,8 @@
 - ``coupled``: balls on the two-way coupled modal plate, its FE reference, plate loads;
 - ``stream``: the fast stream solver (closed-form flight, broad phase, active sets) and the
   slow stream reference;
-- ``records``: ``EventKind`` and ``ContactRecord``, shared by every solver.
+- ``records``: ``EventKind``, ``Event`` and ``Impact`` (the one contact record), shared by every
+  solver.
 
 Depends on the physics layer (``tailbeam.physics``), the plate (``tailbeam.plate``, through
 ``tailbeam.modal``) and the sensor chain (``tailbeam.signals``), never on ``tailbeam.paper``.

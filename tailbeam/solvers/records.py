@@ -2,11 +2,14 @@
 
 ``EventKind`` is the one table of event kinds and ``Event`` the one event record of every
 solver (rigid, coupled two-way and one-way, stream, and their references): each appends
-``Event(t, ball, kind, partner)`` to its ``events``. ``ContactRecord`` and ``LeaveEvent``
-are the stream solvers' records (the refactor of issue 7 extends them to every solver).
+``Event(t, ball, kind, partner)`` to its ``events``. ``Impact`` is the one contact record of
+every solver (``ContactRecord``, ``tailbeam.solvers.rigid.Impact`` and
+``fe_reference.FEImpact`` are other names of it); ``LeaveEvent`` the stream solvers' record
+of a ball leaving the plate.
 """
 
-from dataclasses import asdict, dataclass
+import math
+from dataclasses import dataclass, fields
 from enum import Enum
 from typing import NamedTuple
 
@@ -56,37 +59,131 @@ class Event(NamedTuple):
     partner: str
 
 
-@dataclass
-class ContactRecord:
-    """One contact of one ball (a ball-ball contact gives one record per ball).
+@dataclass(kw_only=True)
+class Impact:
+    """One contact of one ball, as every solver records it (``result.impacts``).
 
-    partner: ``plate`` or the other ball's name. Times in s. Speeds in m/s along the contact
-    normal n (from the partner to the ball): v_in = -v . n at first touch (> 0 approaching),
-    v_out = v . n at the end (> 0 leaving); approach_in / approach_out: the same for the
-    relative velocity of the pair (penetration rate at start, minus it at the end).
-    peak_force (N) at t_peak, max_penetration (m); x, y: contact point in the plate frame
-    at first touch (m). end: ``separated``, ``rest`` (the ball came to rest on the plate: the
-    fast stream solver's rest rules), ``left`` (a ball left the plate during the contact) or
-    ``duration`` (the simulation ended during it; v_out etc. are nan).
+    Created by every solver and reference (rigid, coupled two-way and one-way, stream, FE
+    reference) with keyword arguments only; a ball-ball contact gives one record per ball.
+    The stream solvers create it at first touch and fill the end later: the defaults are
+    those of a contact still in progress.
+
+    Parameters
+    ----------
+    ball : str
+        Name of the ball the record belongs to.
+    t_start : float
+        Time of first touch (s).
+    x, y : float
+        Contact point in the plate frame at first touch (m); for a single-ball solver the
+        ball centre's lateral position then (its lateral motion is uniform).
+    v_in : float
+        The ball's speed along the contact normal n (from the partner to the ball) at
+        first touch, v_in = -v . n (m/s, > 0 approaching).
+    partner : str
+        ``plate`` (``PLATE``) or the other ball's name.
+    index : int
+        The ball's contacts counted 1, 2, ... in time order, with the plate and with balls
+        (0 until the stream result numbers them, ``number_contacts``).
+    approach_in : float
+        The pair's normal approach speed at first touch (m/s, the penetration rate); for a
+        plate contact the ball's own v_in (the plate's motion not subtracted).
+    t_end : float
+        Time the contact ended (s); nan while in progress, and in the stream solvers if
+        the simulation ended during it.
+    v_out : float
+        The ball's speed along n at the end, v_out = v . n (m/s, > 0 leaving); 0.0 if a
+        single-ball solver declared the ball at rest in contact, nan if the simulation
+        ended during the contact.
+    approach_out : float
+        The pair's separation speed at the end (m/s); for a plate contact the ball's v_out.
+    peak_force : float
+        Largest contact force (N), at ``t_peak`` (s).
+    t_peak : float
+        Time of the peak force (s).
+    max_penetration : float
+        Largest penetration of the pair (m).
+    next_apex_height : float
+        Height (m) of the ball's lowest point above the plate at the apex of the flight
+        that follows (nan if there is none, if the ball touches anything or leaves the
+        plate first, for ball-ball rows, and in the FE reference, which does not fly on).
+    end : str
+        How the contact ended: ``separated``, ``rest`` (the ball came to rest on the plate:
+        the solver's rest rules), ``left`` (the ball left the plate during the contact) or
+        ``duration`` (the simulation ended during it).
     """
 
     ball: str
-    partner: str
     t_start: float
     x: float
     y: float
     v_in: float
-    approach_in: float
+    partner: str = PLATE
+    index: int = 0
+    approach_in: float = float("nan")
     t_end: float = float("nan")
     v_out: float = float("nan")
     approach_out: float = float("nan")
     peak_force: float = 0.0
     t_peak: float = float("nan")
     max_penetration: float = 0.0
+    next_apex_height: float = float("nan")
     end: str = "duration"
 
+    @property
+    def restitution(self) -> float:
+        """Coefficient of restitution (dimensionless): approach_out / approach_in (v_out / v_in
+        for a plate contact), nan unless the contact ended by separation or rest and
+        approach_in > 0 (single-ball solvers: 0.0 for a ball declared at rest in contact,
+        where v_out = 0)."""
+        if self.end in ("separated", "rest") and self.approach_in > 0.0:
+            return self.approach_out / self.approach_in
+        return math.nan
+
+    @property
+    def ends_at_rest(self) -> bool:
+        """True if the ball came to rest on the plate during this contact (end ``rest``)."""
+        return self.end == "rest"
+
+    @property
+    def duration(self) -> float:
+        """t_end - t_start (s)."""
+        return self.t_end - self.t_start
+
+    @classmethod
+    def single_ball(cls, ball, *, t_start, v_in, v_out, at_rest, **other) -> "Impact":
+        """A single-ball solver's contact with the plate (rigid, coupled, FE reference).
+
+        Parameters
+        ----------
+        ball : Ball or Pair
+            The ball: ``name``, initial ``position`` (m) and ``velocity`` (m/s); its lateral
+            motion is uniform, so x, y = position[:2] + velocity[:2] t_start.
+        t_start, v_in, v_out : float
+            As the fields (s, m/s, m/s); the approach speeds are the ball's (v_in, v_out).
+        at_rest : bool
+            The ball was declared at rest in this contact (``end`` = ``rest``); otherwise
+            ``end`` is ``duration`` if v_out is nan (the run ended during it), else
+            ``separated``.
+        **other
+            The remaining fields (index, t_end, peak_force, t_peak, max_penetration,
+            next_apex_height).
+        """
+        x = ball.position[0] + ball.velocity[0] * t_start
+        y = ball.position[1] + ball.velocity[1] * t_start
+        end = "rest" if at_rest else ("duration" if math.isnan(v_out) else "separated")
+        return cls(ball=ball.name, partner=PLATE, t_start=t_start, x=x, y=y, v_in=v_in,
+                   approach_in=v_in, v_out=v_out, approach_out=v_out, end=end, **other)  # fmt: skip
+
     def as_dict(self) -> dict:
-        return asdict(self)
+        """Every field, then ``restitution`` and ``ends_at_rest``."""
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        out["restitution"] = self.restitution
+        out["ends_at_rest"] = self.ends_at_rest
+        return out
+
+
+ContactRecord = Impact  # the stream solvers' former name (same class)
 
 
 @dataclass(frozen=True)

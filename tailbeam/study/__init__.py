@@ -1,6 +1,7 @@
 """Labelled vibration datasets and how separable coal and gangue are (``tailbeam[study]``).
 
-- ``design``: the sweep file (base scene, axes, repeats) and its expansion into cases;
+- ``sweep_file``: the sweep file (base scene, axes, repeats), with ``scene_keys`` (its dotted keys);
+- ``design``: its expansion into cases, with ``labels`` (a case's coal / gangue labels);
 - ``case``: one case, run on a Dask worker (labels, signals, impacts);
 - ``sweep``: running the cases on Dask (local cluster or a scheduler), resumable;
 - ``dataset``: the on-disk dataset (dataset.zarr, impacts.parquet, cases.csv);

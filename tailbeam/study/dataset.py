@@ -39,7 +39,7 @@ LABEL_COLUMNS = (
     "n_coal_impacts",
     "n_gangue_impacts",
 )
-# labels of stream scenes only (tailbeam.study.design.stream_labels, tailbeam.study.case)
+# labels of stream scenes only (tailbeam.study.labels.stream_labels, tailbeam.study.case)
 STREAM_LABEL_COLUMNS = ("gangue_mass_fraction", "n_particles")
 STREAM_RESULT_COLUMNS = ("n_ball_contacts",)
 LEDGER_COLUMNS = (

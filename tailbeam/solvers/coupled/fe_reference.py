@@ -15,8 +15,9 @@ bracketed and solved by Brent's method.
 
 Contact start and end are located inside their step (cubic Hermite interpolation of the
 penetration from its values and rates at both step ends); the ball's speed there gives the
-restitution. The peak force and the maximum penetration are refined by a parabola through the
-three nodes around the largest one. Nothing is shared with the modal solver
+restitution. The peak force (and its time) and the maximum penetration are refined by a
+parabola through the three nodes around the largest one; the contacts are ``Impact`` records
+(``tailbeam.solvers.records``, as every solver's). Nothing is shared with the modal solver
 (``tailbeam.solvers.coupled.solver``) but the mesh, the element assembly and the contact law's
 formula.
 
@@ -34,25 +35,12 @@ from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball
 from tailbeam.physics.contact_law import ImpactLaw, impact_force_scalar
 from tailbeam.progress import task
+from tailbeam.solvers.records import Impact
 
 DEFAULT_MAX_WORK = 1e11  # steps x 10 x matrix nonzeros; 1e11 is ~1-2 min on one core
 
 
-@dataclass
-class FEImpact:
-    """One located contact of the reference: times s, speeds m/s, force N, penetration m."""
-
-    t_start: float
-    t_end: float
-    v_in: float
-    v_out: float
-    restitution: float
-    peak_force: float
-    max_penetration: float
-
-    @property
-    def duration(self) -> float:
-        return self.t_end - self.t_start
+FEImpact = Impact  # the reference's former record (same class; ``duration`` included)
 
 
 @dataclass
@@ -151,15 +139,16 @@ def _hermite_root(d0, r0, d1, r1, dt):
 
 
 def _parabola_peak(t, y, j):
-    """Vertex of the parabola through nodes j-1, j, j+1 (uniform steps), or the node."""
+    """(value, time) of the vertex of the parabola through nodes j-1, j, j+1 (uniform
+    steps), or of the node."""
     if j <= 0 or j >= len(y) - 1:
-        return float(y[j])
+        return float(y[j]), float(t[j])
     y0, y1, y2 = y[j - 1], y[j], y[j + 1]
     curv = y0 - 2 * y1 + y2
     if curv >= 0:
-        return float(y1)
+        return float(y1), float(t[j])
     s = 0.5 * (y0 - y2) / curv
-    return float(y1 - 0.25 * (y0 - y2) * s)
+    return float(y1 - 0.25 * (y0 - y2) * s), float(t[j] + s * (t[j + 1] - t[j]))
 
 
 def fe_reference(
@@ -203,7 +192,7 @@ def fe_reference(
         penetration=hist[1],
         sensor_w=sw,
         sensor_a=sa,
-        impacts=_impacts(t_hist, hist, vz_hist, dt),
+        impacts=_impacts(ball, t_hist, hist, vz_hist, dt),
         dt=dt,
         n_dofs=model.n_dofs,
         info={"load_radius": load_radius, "rayleigh": tuple(rayleigh), "steps": n_steps},
@@ -246,8 +235,8 @@ def _integrate(plate, probe, ball, law, n_steps, gravity, bar):
     return hist, vz_hist, sw, sa
 
 
-def _impacts(t, hist, vz, dt):
-    """Located contacts from the step histories (see the module docstring)."""
+def _impacts(ball, t, hist, vz, dt):
+    """Located contacts of ``ball`` from the step histories (see the module docstring)."""
     force, delta, rate = hist
     inside = delta > 0.0
     starts = np.flatnonzero(~inside[:-1] & inside[1:])
@@ -260,20 +249,22 @@ def _impacts(t, hist, vz, dt):
         k1 = int(later[0])
         s0 = _hermite_root(delta[k0], rate[k0], delta[k0 + 1], rate[k0 + 1], dt)
         s1 = _hermite_root(delta[k1], rate[k1], delta[k1 + 1], rate[k1 + 1], dt)
-        v_in = -(vz[k0] + s0 * (vz[k0 + 1] - vz[k0]))
-        v_out = vz[k1] + s1 * (vz[k1 + 1] - vz[k1])
+        v_in = float(-(vz[k0] + s0 * (vz[k0 + 1] - vz[k0])))
+        v_out = float(vz[k1] + s1 * (vz[k1 + 1] - vz[k1]))
         seg = slice(k0, k1 + 2)
-        jf = int(np.argmax(force[seg]))
-        jd = int(np.argmax(delta[seg]))
+        peak, t_peak = _parabola_peak(t[seg], force[seg], int(np.argmax(force[seg])))
         out.append(
-            FEImpact(
+            Impact.single_ball(
+                ball,
+                index=len(out) + 1,
                 t_start=float(t[k0] + s0 * dt),
                 t_end=float(t[k1] + s1 * dt),
-                v_in=float(v_in),
-                v_out=float(v_out),
-                restitution=float(v_out / v_in),
-                peak_force=_parabola_peak(t[seg], force[seg], jf),
-                max_penetration=_parabola_peak(t[seg], delta[seg], jd),
+                v_in=v_in,
+                v_out=v_out,
+                peak_force=peak,
+                t_peak=t_peak,
+                max_penetration=_parabola_peak(t[seg], delta[seg], int(np.argmax(delta[seg])))[0],
+                at_rest=False,
             )
         )
     return out
@@ -283,11 +274,11 @@ QUANTITIES = ("restitution", "peak_force", "duration", "max_penetration")
 
 
 def impact_quantities(impact) -> dict:
-    """The four compared contact quantities of an impact (FEImpact or rigid Impact)."""
+    """The four compared contact quantities of an ``Impact`` (any solver's)."""
     return {
         "restitution": impact.restitution,
         "peak_force": impact.peak_force,
-        "duration": impact.t_end - impact.t_start,
+        "duration": impact.duration,
         "max_penetration": impact.max_penetration,
     }
 

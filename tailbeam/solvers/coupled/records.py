@@ -7,7 +7,7 @@ import weakref
 import numpy as np
 
 from tailbeam.modal import ModalBasis
-from tailbeam.solvers.rigid.result import Impact
+from tailbeam.solvers.records import Impact
 
 _COMPLIANCE_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
@@ -56,17 +56,16 @@ def close_contact(info, b, ball, t_end, v_out, bufs, nbuf, radius, gravity, *, a
     apex = math.nan
     if not at_rest and math.isfinite(v_out) and v_out > 0:
         apex = float(z) - radius + (v_out**2 / (2 * gravity) if gravity > 0 else math.inf)
-    return Impact(
-        ball=ball.name,
+    return Impact.single_ball(
+        ball,
         index=info["index"],
         t_start=float(info["t_start"]),
         t_end=float(t_end),
         v_in=v_in,
         v_out=0.0 if at_rest else v_out,
-        restitution=(0.0 if at_rest else v_out) / v_in if v_in > 0 else math.nan,
         peak_force=peak,
         t_peak=t_peak,
         max_penetration=float(np.max(ds)) if len(ds) else math.nan,
         next_apex_height=apex,
-        ends_at_rest=bool(at_rest),
+        at_rest=bool(at_rest),
     )

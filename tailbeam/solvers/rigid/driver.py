@@ -20,9 +20,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tailbeam.errors import WorkLimitError
-from tailbeam.solvers.records import PLATE, Event, EventKind
+from tailbeam.solvers.records import PLATE, Event, EventKind, Impact
 from tailbeam.solvers.rigid.model import Pair, time_to_contact
-from tailbeam.solvers.rigid.result import Impact, RigidResult
+from tailbeam.solvers.rigid.result import RigidResult
 from tailbeam.solvers.rigid.trajectory import TrajectoryBuilder
 
 
@@ -142,19 +142,18 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
     v_out = {"separated": out.v_out, "rest": 0.0}.get(out.status, math.nan)
     apex = v_out**2 / (2.0 * p.gravity) if p.gravity > 0.0 and out.status == "separated" else None
     st.impacts.append(
-        Impact(
-            ball=p.name,
+        Impact.single_ball(
+            p,
             index=index,
             t_start=tc,
             t_end=t_end,
             v_in=v_in,
             v_out=v_out,
-            restitution=v_out / v_in if v_in > 0.0 else math.nan,
             peak_force=out.peak_force,
             t_peak=tc + out.tau_peak,
             max_penetration=out.max_penetration,
             next_apex_height=math.nan if (apex is None or at_rest) else apex,
-            ends_at_rest=at_rest,
+            at_rest=at_rest,
         )
     )
     if at_rest:
@@ -171,21 +170,12 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
 def _rest(st, tc, index, v_in, v_out, t_end):
     p = st.pair
     st.impacts.append(
-        Impact(
-            p.name,
-            index,
-            tc,
-            t_end,
-            v_in,
-            v_out,
-            math.nan if v_in == 0.0 else v_out / v_in,
-            p.mass * p.gravity,
-            tc,
-            p.delta_static,
-            math.nan,
-            True,
+        Impact.single_ball(
+            p, index=index, t_start=tc, t_end=t_end, v_in=v_in, v_out=v_out,
+            peak_force=p.mass * p.gravity, t_peak=tc, max_penetration=p.delta_static,
+            at_rest=True,
         )
-    )
+    )  # fmt: skip
     st.events.append(Event(t_end, p.name, EventKind.REST, PLATE))
     st.builder.rest(t_end, p.radius - p.delta_static, p.mass * p.gravity)
     st.rest_time = t_end

@@ -10,37 +10,10 @@ how it ended.
 from dataclasses import dataclass, field
 
 from tailbeam.result import BallsResult
-from tailbeam.solvers.records import EventKind
+from tailbeam.solvers.records import EventKind, Impact  # noqa: F401 - Impact: its old home
 
 EVENT_KINDS = (EventKind.CONTACT_START, EventKind.FULL_DAMPING, EventKind.CLAMP_ON,
                EventKind.CLAMP_OFF, EventKind.CONTACT_END, EventKind.REST)  # fmt: skip
-
-
-@dataclass(frozen=True)
-class Impact:
-    """One contact of a ball with the plate (times in s, speeds in m/s, SI throughout).
-
-    v_in/v_out are magnitudes; v_out = 0.0 if the ball did not separate (declared at rest in
-    contact) and nan if the simulation ended during the contact. restitution = v_out / v_in
-    (nan if v_in = 0 or v_out is nan). next_apex_height: height in m of the ball's lowest point
-    above the plate at the apex of the following flight (nan if there is none).
-    """
-
-    ball: str
-    index: int
-    t_start: float
-    t_end: float
-    v_in: float
-    v_out: float
-    restitution: float
-    peak_force: float
-    t_peak: float
-    max_penetration: float
-    next_apex_height: float
-    ends_at_rest: bool
-
-    def as_dict(self) -> dict:
-        return {name: getattr(self, name) for name in self.__dataclass_fields__}
 
 
 @dataclass

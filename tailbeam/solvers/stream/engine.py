@@ -51,14 +51,7 @@ def stream_engine() -> StreamEngine:
     except ModuleNotFoundError as err:
         if err.name != FAST_MODULE:
             raise
-        return StreamEngine(
-            "reference (scipy DOP853, all pairs watched)",
-            run_reference,
-            REFERENCE_MAX_PARTICLES,
-            REFERENCE_RTOL,
-            REFERENCE_MAX_STEPS,
-            reference_estimate,
-        )
+        return reference_engine()
     return StreamEngine(
         "fast stream solver",
         fast.simulate_stream,
@@ -66,6 +59,18 @@ def stream_engine() -> StreamEngine:
         getattr(fast, "DEFAULT_RTOL", REFERENCE_RTOL),
         getattr(fast, "DEFAULT_MAX_STEPS", REFERENCE_MAX_STEPS),
         getattr(fast, "estimate", reference_estimate),
+    )
+
+
+def reference_engine() -> StreamEngine:
+    """The slow independent reference (``simulate_stream_reference``), as a StreamEngine."""
+    return StreamEngine(
+        "stream reference (scipy DOP853, all pairs watched)",
+        run_reference,
+        REFERENCE_MAX_PARTICLES,
+        REFERENCE_RTOL,
+        REFERENCE_MAX_STEPS,
+        reference_estimate,
     )
 
 

@@ -1,4 +1,4 @@
-"""The stream driver's records: contacts as ``ContactRecord``, the plate's loads for the
+"""The stream driver's records: contacts as ``Impact``, the plate's loads for the
 sensors, and the energy ledger (``tailbeam.solvers.stream.stream``; a mixin of its event loop,
 which provides ``balls``, ``act``, ``t``, ``open``, ``contacts``, ``events``, ``loads``,
 ``dead_loads``, ``limit``, ``rest_speed`` and ``stats``)."""
@@ -9,7 +9,7 @@ import numpy as np
 
 from tailbeam.physics.contact_law import elastic_energy
 from tailbeam.physics.hertz import hertz_contact_duration
-from tailbeam.solvers.records import PLATE, ContactRecord, Event, EventKind
+from tailbeam.solvers.records import PLATE, Event, EventKind, Impact
 from tailbeam.solvers.stream.stream_state import GONE, PENDING, SLIDE
 
 REST_CONTACT_FACTOR = 50.0  # a plate contact longer than this many Hertz durations is at rest
@@ -37,11 +37,15 @@ class StreamRecords:
         w = vi - (vj if vj is not None else 0.0)
         rate = float(-(w @ n))
         partner = PLATE if j < 0 else b.names[j]
-        recs = [ContactRecord(b.names[i], partner, t, point[0], point[1], float(-(vi @ n)), rate)]
+        recs = [
+            Impact(ball=b.names[i], partner=partner, t_start=t, x=point[0], y=point[1],
+                   v_in=float(-(vi @ n)), approach_in=rate)
+        ]  # fmt: skip
         if j >= 0:
             recs.append(
-                ContactRecord(b.names[j], b.names[i], t, point[0], point[1], float(vj @ n), rate)
-            )
+                Impact(ball=b.names[j], partner=b.names[i], t_start=t, x=point[0], y=point[1],
+                       v_in=float(vj @ n), approach_in=rate)
+            )  # fmt: skip
         self.act.reset_accumulators(key)
         self.open[key] = recs
         if j < 0:

@@ -6,7 +6,9 @@ the outputs ``impacts.csv`` and ``particles.csv`` (tailbeam.io.results_io), colu
 
 A ``tailbeam.result.Result``: the columns of ``impacts_table()`` and ``particles_table()``
 are documented there (``IMPACT_TABLE_COLUMNS``, ``PARTICLE_COLUMNS``); this module fills the
-twelve historical ones from the stream records:
+twelve historical ones from the stream records (``tailbeam.solvers.records.Impact``, the
+record of every solver), of which it numbers ``index`` and sets ``next_apex_height`` when
+built (``number_contacts``: both need the whole run):
 ``restitution`` is approach_out / approach_in of the pair (v_out / v_in for a plate row),
 nan unless the contact ended by separation (or rest) and approach_in > 0;
 ``next_apex_height`` (plate rows): v_out^2 / (2 g cos theta), nan if the contact did not end
@@ -47,7 +49,7 @@ class StreamResult(Result):
     """Result of a stream simulation (see the module docstring).
 
     particles: ``tailbeam.streams.generator.Particle`` of every body, ``[[balls]]`` included
-    (stream "", t_release 0); contacts: ``ContactRecord`` (one per ball per contact);
+    (stream "", t_release 0); contacts: ``Impact`` records (one per ball per contact);
     leaves: ``LeaveEvent``; events: ``tailbeam.solvers.records.Event`` in time order; incline:
     ``tailbeam.physics.incline.InclinedPlate``; duration in s; status 0 = reached the end;
     message; stats: solver statistics (steps, ...); sensors: sensor outputs by name once
@@ -87,14 +89,25 @@ class StreamResult(Result):
     def particle_records(self) -> list:
         return list(self.particles)
 
+    def __post_init__(self):
+        number_contacts(self.contacts, self.leaves, self.incline)
+
     def _impact_rows(self):
-        leave = {e.ball: e.time for e in self.leaves}
-        starts = _starts_by_ball(self.contacts)
-        g_n = self.incline.gravity * math.cos(math.radians(self.incline.inclination))
-        count: dict = {}
-        for rec in sorted(self.contacts, key=lambda r: (r.t_start, r.ball)):
-            count[rec.ball] = count.get(rec.ball, 0) + 1
-            yield _twelve(rec, count[rec.ball], g_n, starts, leave), rec
+        return sorted(self.contacts, key=lambda r: (r.t_start, r.ball))
+
+
+def number_contacts(contacts, leaves, incline) -> None:
+    """Fill ``index`` (1, 2, ... per ball in time order) and ``next_apex_height`` of a stream
+    solver's ``Impact`` records (``contacts``), which need the whole run: the ball's later
+    contacts and its ``LeaveEvent`` (``leaves``) on ``incline``. Idempotent."""
+    leave = {e.ball: e.time for e in leaves}
+    starts = _starts_by_ball(contacts)
+    g_n = incline.gravity * math.cos(math.radians(incline.inclination))
+    count: dict = {}
+    for rec in sorted(contacts, key=lambda r: (r.t_start, r.ball)):
+        count[rec.ball] = count.get(rec.ball, 0) + 1
+        rec.index = count[rec.ball]
+        rec.next_apex_height = _next_apex(rec, g_n, starts.get(rec.ball), leave.get(rec.ball))
 
 
 def _starts_by_ball(contacts) -> dict:
@@ -102,18 +115,6 @@ def _starts_by_ball(contacts) -> dict:
     for rec in contacts:
         out.setdefault(rec.ball, []).append(rec.t_start)
     return {k: np.sort(v) for k, v in out.items()}
-
-
-def _twelve(rec, index, g_n, starts, leave) -> tuple:
-    separated = rec.end in ("separated", "rest")
-    restitution = (
-        rec.approach_out / rec.approach_in if separated and rec.approach_in > 0.0 else math.nan
-    )
-    return (
-        rec.ball, index, rec.t_start, rec.t_end, rec.v_in, rec.v_out, restitution,
-        rec.peak_force, rec.t_peak, rec.max_penetration,
-        _next_apex(rec, g_n, starts.get(rec.ball), leave.get(rec.ball)), rec.end == "rest",
-    )  # fmt: skip
 
 
 def _next_apex(rec, g_n, starts, t_leave) -> float:
