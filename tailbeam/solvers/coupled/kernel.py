@@ -167,11 +167,10 @@ def _certify(b, tau, ctx, st, out, g, L, A, gap0, rate0, guess):
     return -1.0, 0.0, 0.0, 0.0
 
 
-@njit(cache=True)
-def _pending_event(st, d, clampf):
+@njit(cache=True, inline="always")
+def _pending_event(F, mode, deep, cur, d, clampf):
     """Apply the first event that happened at the same instant as the one that ended the
     previous run (found in the step-end quantities ``cur``): (kind, ball), or EV_NONE."""
-    _q, _qd, _z, _vz, F, mode, deep, cur, _hist = st
     for b in range(mode.shape[0]):
         touching = mode[b] == CONTACT or mode[b] == CLAMPED
         if mode[b] == FLIGHT and cur[0, b] >= 0.0:
@@ -196,7 +195,7 @@ def _pending_event(st, d, clampf):
     return EV_NONE, -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _flight_step(ctx, st, remaining, h, g, fm):
     """Step (s) with no ball in contact: the certified horizon before any flying ball can
     touch (from the bounds of ``_bounds`` on the gap), at least its h, at most remaining."""
@@ -228,11 +227,10 @@ def _flight_step(ctx, st, remaining, h, g, fm):
     return tau
 
 
-@njit(cache=True)
-def _step_length(ctx, st, remaining, h, g, fm):
+@njit(cache=True, inline="always")
+def _step_length(ctx, st, mode, remaining, h, g, fm):
     """Next step (s): the smallest contact step h[b] of the balls in contact, else the
     certified flight horizon (``_flight_step``); at most remaining."""
-    mode = st[5]
     in_contact = False
     for b in range(mode.shape[0]):
         if mode[b] == CONTACT or mode[b] == CLAMPED:
@@ -247,11 +245,10 @@ def _step_length(ctx, st, remaining, h, g, fm):
     return min(tau, remaining)
 
 
-@njit(cache=True)
-def _contact_kinds(b, st, aux, d, clampf, kinds):
+@njit(cache=True, inline="always")
+def _contact_kinds(b, mode, deep, aux, d, clampf, kinds):
     """The events of touching ball b whose function changed sign over the step (step-end
     quantities aux) into kinds; returns their number."""
-    mode, deep = st[5], st[6]
     nk = 0
     if aux[0, b] < 0.0:
         kinds[nk] = EV_END
@@ -268,7 +265,7 @@ def _contact_kinds(b, st, aux, d, clampf, kinds):
     return nk
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _keep(hit, kd, b, best, kind_best, b_best, out2, out_best):
     """Keep event kd of ball b at hit (s) (solution in out2) if it is the earliest so far."""
     if hit < best or kind_best == EV_NONE:
@@ -277,15 +274,14 @@ def _keep(hit, kd, b, best, kind_best, b_best, out2, out_best):
     return best, kind_best, b_best
 
 
-@njit(cache=True)
-def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kind_best, b_best):
+@njit(cache=True, inline="always")
+def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kind_best, b_best,
+                 mode, deep, cur, d, clampf):  # fmt: skip
     """Locate the events of ball b in the step of tau (s) and keep the earliest of all
     (``_keep``); returns (ok, best, kind_best, b_best), ok False if a step solve failed."""
-    d, clampf = ctx[9], ctx[10]
-    mode, cur = st[5], st[7]
     if mode[b] == CONTACT or mode[b] == CLAMPED:
         kinds = np.zeros(4, dtype=np.int64)
-        for kk in range(_contact_kinds(b, st, aux, d, clampf, kinds)):
+        for kk in range(_contact_kinds(b, mode, deep, aux, d, clampf, kinds)):
             kd = kinds[kk]
             f_lo = _event_value(kd, b, cur, d)
             f_hi = _event_value(kd, b, aux, d)
@@ -310,11 +306,10 @@ def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kin
     return True, best, kind_best, b_best
 
 
-@njit(cache=True)
-def _accept(st, out, tau):
-    """Take the step of tau (s) in out as the new state st (and the BDF2 force history)."""
-    q, qd, z, vz, F, mode, _deep, cur, hist = st
-    q1, qd1, z1, vz1, F1, aux, _coef, _f0m, _f1m = out
+@njit(cache=True, inline="always")
+def _accept(q, qd, z, vz, F, mode, cur, hist, q1, qd1, z1, vz1, F1, aux, tau):
+    """Take the step of tau (s) (ending in q1, .., aux) as the new state (q, .., cur), and the
+    BDF2 force history hist."""
     for b in range(mode.shape[0]):
         if mode[b] == CONTACT or mode[b] == CLAMPED:
             hist[0, b] = (F1[b] - F[b]) / tau
@@ -330,22 +325,20 @@ def _accept(st, out, tau):
     cur[:, :] = aux
 
 
-@njit(cache=True)
-def _record(bufs, nbuf, t, st):
+@njit(cache=True, inline="always")
+def _record(bt, bz, bvz, bF, bd, nbuf, t, z, vz, F, cur):
     """Write node nbuf of the buffers: t (s), heights z (m), speeds vz (m/s), forces F (N),
     penetrations delta (m)."""
-    bt, bz, bvz, bF, bd = bufs
     bt[nbuf] = t
-    bz[nbuf, :] = st[2]
-    bvz[nbuf, :] = st[3]
-    bF[nbuf, :] = st[4]
-    bd[nbuf, :] = st[7][0]
+    bz[nbuf, :] = z
+    bvz[nbuf, :] = vz
+    bF[nbuf, :] = F
+    bd[nbuf, :] = cur[0]
 
 
-@njit(cache=True)
-def _apply_event(kind, b, st, d):
+@njit(cache=True, inline="always")
+def _apply_event(kind, b, F, mode, deep, cur, hist, d):
     """Change ball b's mode for the event kind located at the step's end (st accepted)."""
-    _q, _qd, _z, _vz, F, mode, deep, cur, hist = st
     if kind == EV_START:
         mode[b] = CONTACT
         deep[b] = cur[0, b] > d[b]
@@ -372,26 +365,27 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
     Returns (status, t, nbuf, steps). bufs = (t, z, vz, F, delta) node buffers; evout[0:2] =
     (kind, ball) of the event that stopped the run.
     """
-    phi, d = ctx[2], ctx[9]
-    F = st[4]
+    _om, _ze, phi, _cr, _mass, _ra, _k, _e, _c, d, clampf = ctx
+    q, qd, z, vz, F, mode, deep, cur, hist = st
+    bt, bz, bvz, bF, bd = bufs
     nb, n = phi.shape
     out, out2, out_best = _alloc(nb, n), _alloc(nb, n), _alloc(nb, n)
-    F1, aux, f0m, f1m = out[4], out[5], out[7], out[8]
+    q1, qd1, z1, vz1, F1, aux, _coef, f0m, f1m = out
     guess = np.empty(nb)
     fm = np.empty(n)
-    evout[0], evout[1] = _pending_event(st, d, ctx[10])
+    evout[0], evout[1] = _pending_event(F, mode, deep, cur, d, clampf)
     if evout[0] != EV_NONE:
         return ST_EVENT, t, nbuf, 0
     steps = 0
     while t < t_stop:
-        if nbuf >= bufs[0].shape[0]:
+        if nbuf >= bt.shape[0]:
             return ST_FULL, t, nbuf, steps
         if steps >= max_steps:
             return ST_STEPS, t, nbuf, steps
         steps += 1
-        tau = _step_length(ctx, st, t_stop - t, h, g, fm)
+        tau = _step_length(ctx, st, mode, t_stop - t, h, g, fm)
         for b in range(nb):
-            guess[b] = F[b] + st[8][0, b] * tau
+            guess[b] = F[b] + hist[0, b] * tau
             F1[b] = guess[b]
         if not solve_step(tau, ctx, st, out, g):
             return ST_FAIL, t, nbuf, steps
@@ -399,21 +393,21 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
         best, kind_best, b_best = tau, EV_NONE, -1
         L, A = _bounds(ctx, st, f0m, f1m, tau, g)
         for b in range(nb):
-            ok, best, kind_best, b_best = _ball_events(
-                b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kind_best, b_best
-            )
+            ok, best, kind_best, b_best = _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L,
+                                                       A, guess, best, kind_best, b_best, mode,
+                                                       deep, cur, d, clampf)  # fmt: skip
             if not ok:
                 return ST_FAIL, t, nbuf, steps
         if kind_best != EV_NONE:
             # the solution at the located time, exactly as the root finder checked its sign
             tau = best
             _copy_out(out_best, out)
-        _accept(st, out, tau)
+        _accept(q, qd, z, vz, F, mode, cur, hist, q1, qd1, z1, vz1, F1, aux, tau)
         t = t + tau
-        _record(bufs, nbuf, t, st)
+        _record(bt, bz, bvz, bF, bd, nbuf, t, z, vz, F, cur)
         nbuf += 1
         if kind_best != EV_NONE:
-            _apply_event(kind_best, b_best, st, d)
+            _apply_event(kind_best, b_best, F, mode, deep, cur, hist, d)
             evout[0] = kind_best
             evout[1] = b_best
             return ST_EVENT, t, nbuf, steps

@@ -23,7 +23,7 @@ from tailbeam.solvers.coupled.propagator import A1, B1, advance, coefficients
 FLIGHT, CONTACT, CLAMPED, REST, OFF = 0, 1, 2, 3, 4
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _modal_loads(phi, mass, F, mode, g, f0m, f1m):
     """Modal forces (N) at the step's start f0m (the contact forces F) and end f1m (the
     resting balls' weights only: the contact end forces are still unknown)."""
@@ -36,7 +36,7 @@ def _modal_loads(phi, mass, F, mode, g, f0m, f1m):
             f1m -= phi[b] * (mass[b] * g)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _touching(mode):
     """Indices of the balls in contact (CONTACT or CLAMPED) and their number."""
     idx = np.empty(mode.shape[0], dtype=np.int64)
@@ -48,13 +48,11 @@ def _touching(mode):
     return idx, na
 
 
-@njit(cache=True)
-def _contact_system(idx, na, tau, ctx, st, coef, q1, qd1, g):
+@njit(cache=True, inline="always")
+def _contact_system(idx, na, tau, phi, cres, mass, radius, z, vz, F, hist, coef, q1, qd1, g):
     """The penetrations (m) and rates (m/s) at the step's end, linear in the unknown end
     forces x (N) of the touching balls: delta = dfree + S x, delta_dot = vfree + Sv x (the free
     modes q1, qd1 at the end given). Returns (dfree, vfree, S, Sv)."""
-    _om, _ze, phi, cres, mass, radius, _k, _e, _c, _d, _cl = ctx
-    _q, _qd, z, vz, F, _mode, _deep, _cur, hist = st
     n = phi.shape[1]
     dfree, vfree = np.empty(na), np.empty(na)
     S, Sv = np.empty((na, na)), np.empty((na, na))
@@ -82,11 +80,10 @@ def _contact_system(idx, na, tau, ctx, st, coef, q1, qd1, g):
     return dfree, vfree, S, Sv
 
 
-@njit(cache=True)
-def _newton(idx, na, dfree, vfree, S, Sv, x, ctx):
+@njit(cache=True, inline="always")
+def _newton(idx, na, dfree, vfree, S, Sv, x, k, e, c, d, clampf):
     """Solve x = IMPACT(dfree + S x, vfree + Sv x) for the end forces x (N; in: the guess)
     by Newton's method; returns False if 60 iterations do not reach 1e-13 relative."""
-    k, e, c, d, clampf = ctx[6], ctx[7], ctx[8], ctx[9], ctx[10]
     J = np.empty((na, na))
     r = np.empty(na)
     for _it in range(60):
@@ -111,13 +108,12 @@ def _newton(idx, na, dfree, vfree, S, Sv, x, ctx):
     return False
 
 
-@njit(cache=True)
-def _ball_ends(tau, ctx, st, out, g):
-    """Balls at the step's end (cubic in time under the linear force), and the event
-    quantities aux rows: delta (m), delta_dot (m/s), raw force (N), gap' (m/s)."""
-    _om, _ze, phi, cres, mass, radius, k, e, c, d, _cl = ctx
-    _q, _qd, z, vz, F, mode, _deep, _cur, hist = st
-    q1, qd1, z1, vz1, F1, aux, _coef, _f0m, _f1m = out
+@njit(cache=True, inline="always")
+def _ball_ends(tau, phi, cres, mass, radius, k, e, c, d, z, vz, F, mode, hist, q1, qd1, z1, vz1,
+               F1, aux, g):  # fmt: skip
+    """Balls at the step's end (heights z1 m, speeds vz1 m/s, cubic in time under the linear
+    force; resting balls' weights into F1 N) and the event quantities aux rows: delta (m),
+    delta_dot (m/s), raw force (N), gap' (m/s)."""
     for b in range(phi.shape[0]):
         if mode[b] == REST:
             z1[b] = z[b]
@@ -145,26 +141,28 @@ def _ball_ends(tau, ctx, st, out, g):
 @njit(cache=True)
 def solve_step(tau, ctx, st, out, g):
     """Advance ``st`` by ``tau`` into ``out`` (all arrays); returns False if Newton failed."""
-    omega, zeta, phi = ctx[0], ctx[1], ctx[2]
-    q, qd, F, mode = st[0], st[1], st[4], st[5]
-    q1, qd1, F1, coef, f0m, f1m = out[0], out[1], out[4], out[6], out[7], out[8]
+    omega, zeta, phi, cres, mass, radius, k, e, c, d, clampf = ctx
+    q, qd, z, vz, F, mode, _deep, _cur, hist = st
+    q1, qd1, z1, vz1, F1, aux, coef, f0m, f1m = out
     n = phi.shape[1]
     if coef[0, n] != tau:  # the last column remembers the tau of the table (contact steps repeat)
         coefficients(omega, zeta, tau, coef)
         coef[0, n] = tau
-    _modal_loads(phi, ctx[4], F, mode, g, f0m, f1m)
+    _modal_loads(phi, mass, F, mode, g, f0m, f1m)
     advance(coef, q, qd, f0m, f1m, q1, qd1)  # free part (contact end forces still zero)
     idx, na = _touching(mode)
     if na > 0:
-        dfree, vfree, S, Sv = _contact_system(idx, na, tau, ctx, st, coef, q1, qd1, g)
+        dfree, vfree, S, Sv = _contact_system(idx, na, tau, phi, cres, mass, radius, z, vz, F,
+                                              hist, coef, q1, qd1, g)  # fmt: skip
         x = np.empty(na)
         for jj in range(na):
             x[jj] = F1[idx[jj]]  # caller's guess
-        if not _newton(idx, na, dfree, vfree, S, Sv, x, ctx):
+        if not _newton(idx, na, dfree, vfree, S, Sv, x, k, e, c, d, clampf):
             return False
         for jj in range(na):
             F1[idx[jj]] = x[jj]
             f1m -= phi[idx[jj]] * x[jj]
         advance(coef, q, qd, f0m, f1m, q1, qd1)
-    _ball_ends(tau, ctx, st, out, g)
+    _ball_ends(tau, phi, cres, mass, radius, k, e, c, d, z, vz, F, mode, hist, q1, qd1, z1, vz1,
+               F1, aux, g)  # fmt: skip
     return True

@@ -9,8 +9,8 @@ tables are scipy's (``dop853_tables``, read at run time and passed in as arrays)
 import math
 
 import numpy as np
-from numba import njit
 
+from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.rigid.regions import MAX_FACTOR, MIN_FACTOR, SAFETY, accel
 
 
@@ -23,7 +23,7 @@ def dop853_tables():
     )
 
 
-@njit(cache=True)
+@helper_njit
 def stages(K, A, first, stop, y0, y1, h, ramp, clamped, par):
     """Runge-Kutta stages first..stop-1 of the state (delta m, u m/s) into K (rows: stages,
     columns: d delta/dt m/s, du/dt m/s^2) for a step of h (s)."""
@@ -38,7 +38,7 @@ def stages(K, A, first, stop, y0, y1, h, ramp, clamped, par):
         K[s, 1] = accel(y0 + h * s0, uu, ramp, clamped, par)
 
 
-@njit(cache=True)
+@helper_njit
 def step(K, A, B, E3, E5, y0, y1, f0, f1, h, ramp, clamped, par, rtol, atol0, atol1):
     """One DOP853 step of h (s) from (delta y0 m, u y1 m/s) with slopes (f0, f1) there.
 
@@ -72,7 +72,7 @@ def step(K, A, B, E3, E5, y0, y1, f0, f1, h, ramp, clamped, par, rtol, atol0, at
     return n0, n1, err
 
 
-@njit(cache=True)
+@helper_njit
 def dense_coefficients(K, A, D, y0, y1, n0, n1, f0, f1, h, ramp, clamped, par, coef):
     """The 7 x 2 dense-output coefficients ``coef`` of an accepted step of h (s) from
     (y0 m, y1 m/s) to (n0, n1) (3 extra stages into K[13..15]; ``regions.dense_eval``)."""
@@ -92,7 +92,7 @@ def dense_coefficients(K, A, D, y0, y1, n0, n1, f0, f1, h, ramp, clamped, par, c
             coef[3 + i, q] = h * acc
 
 
-@njit(cache=True)
+@helper_njit
 def growth(err, rejected):
     """Factor of the next step after an accepted one with error norm err (not above 1 right
     after a rejection)."""
@@ -102,7 +102,7 @@ def growth(err, rejected):
     return factor
 
 
-@njit(cache=True)
+@helper_njit
 def shrink(err):
     """Factor of the retried step after a rejected one (error norm err > 1, or NaN)."""
     return max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0)) if err > 1.0 else MIN_FACTOR

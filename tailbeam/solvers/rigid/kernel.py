@@ -31,6 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
+from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.rigid.dop853 import (  # noqa: F401  (dop853_tables: re-exported)
     dense_coefficients,
     dop853_tables,
@@ -76,7 +77,7 @@ R_TAU, R_VOUT, R_PEAK, R_TPEAK, R_PEN = range(5)
 I_STATUS, I_PIECES, I_EVENTS, I_NFEV, I_STEPS, I_ATTEMPTS = range(6)
 
 
-@njit(cache=True)
+@helper_njit
 def _watch_flags(direction, active, ramp, clamped, to_end, par):
     """Crossing direction (+1 up, -1 down) and whether each watched function is watched in
     the region (ramp, clamped); to_end: the step ends at the separation already located."""
@@ -94,7 +95,7 @@ def _watch_flags(direction, active, ramp, clamped, to_end, par):
     active[W_PEAK] = not clamped
 
 
-@njit(cache=True)
+@helper_njit
 def _watch_step(y0, y1, n0, n1, coef, ramp, clamped, par, fresh_w, direction, G, buf):
     """Watched functions at the step's start, its 3 interior points and its end into the rows
     of G (x = 0, 0.25, 0.5, 0.75, 1); the restart function fresh_w (0 at x = 0) divided by
@@ -113,7 +114,7 @@ def _watch_step(y0, y1, n0, n1, coef, ramp, clamped, par, fresh_w, direction, G,
     return force_a, force_b
 
 
-@njit(cache=True)
+@helper_njit
 def _first_kink(active, direction, G, fresh_w, y0, y1, coef, ramp, clamped, par, buf, xtol):
     """Earliest crossing (x_sw, w_sw) in the step of a terminal watched function (kinks,
     separation, rest): x_sw in [0, 1] of the step, w_sw = -1 (x_sw = 2) if none."""
@@ -138,7 +139,7 @@ def _first_kink(active, direction, G, fresh_w, y0, y1, coef, ramp, clamped, par,
     return x_sw, w_sw
 
 
-@njit(cache=True)
+@helper_njit
 def _maxima(active, G, x_end, tau, h, y0, y1, coef, ramp, clamped, par, buf, xtol, force_a,
             res):  # fmt: skip
     """Update the maxima of the penetration (m) and of the force (N, at tau_peak s) in res
@@ -167,7 +168,7 @@ def _maxima(active, G, x_end, tau, h, y0, y1, coef, ramp, clamped, par, buf, xto
     _update_maxima(res, force_a, tau, y0, pen, peak, tau_peak)
 
 
-@njit(cache=True)
+@helper_njit
 def _update_maxima(res, force, tau_f, delta, pen, peak, tau_peak):
     """Write the maxima (pen m, peak N at tau_peak s) into res after comparing them with a
     force (N) at tau_f (s) and a penetration delta (m)."""
@@ -178,7 +179,7 @@ def _update_maxima(res, force, tau_f, delta, pen, peak, tau_peak):
     res[R_TPEAK] = tau_peak
 
 
-@njit(cache=True)
+@helper_njit
 def _examine(K, A, D, y0, y1, n0, n1, f0, f1, tau, h, h0, ramp, clamped, par, fresh_w, to_end,
              W, res, ires):  # fmt: skip
     """Dense output (into W[0]; counted in ires) and events of a step of h (s) from tau (s)
@@ -205,7 +206,7 @@ def _examine(K, A, D, y0, y1, n0, n1, f0, f1, tau, h, h0, ramp, clamped, par, fr
     return x_sw, w_sw, False, force_b
 
 
-@njit(cache=True)
+@helper_njit
 def _store_piece(p_tau, p_h, p_y, p_coef, ires, tau, h, y0, y1, coef):
     """Append a dense-output piece: start tau (s), length h (s), start state, coefficients;
     returns False (nothing written) if a buffer is full."""
@@ -223,7 +224,7 @@ def _store_piece(p_tau, p_h, p_y, p_coef, ires, tau, h, y0, y1, coef):
     return True
 
 
-@njit(cache=True)
+@helper_njit
 def _at_kink(x_sw, tau, h, y0, y1, coef, ramp, clamped, par, buf, res):
     """State at the located crossing x_sw of the step: (tau_ev s, delta m, u m/s); the
     maxima in res updated with it."""
@@ -234,7 +235,7 @@ def _at_kink(x_sw, tau, h, y0, y1, coef, ramp, clamped, par, buf, res):
     return tau_ev, d_ev, u_ev
 
 
-@njit(cache=True)
+@helper_njit
 def _switch_region(w_sw, d_ev, ramp, clamped, par):
     """The region after kink w_sw (full damping or clamp): (delta m to restart from, ramp,
     clamped, event code); the full-damping restart sits exactly on delta = d."""
@@ -244,7 +245,7 @@ def _switch_region(w_sw, d_ev, ramp, clamped, par):
     return d_ev, ramp, clamped, EV_CLAMP_ON if clamped else EV_CLAMP_OFF
 
 
-@njit(cache=True)
+@helper_njit
 def _log(ev_tau, ev_kind, ires, tau, kind):
     """Append event (tau s, kind) to the event buffer (its room checked per step)."""
     ev_tau[ires[I_EVENTS]] = tau
@@ -252,7 +253,7 @@ def _log(ev_tau, ev_kind, ires, tau, kind):
     ires[I_EVENTS] += 1
 
 
-@njit(cache=True)
+@helper_njit
 def _finish(res, ires, status, tau, v_out):
     """End status and time (s), rebound speed (m/s; NaN unless separated, 0 at rest)."""
     ires[I_STATUS] = status

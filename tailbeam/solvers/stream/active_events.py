@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.stream.active_pairs import (
     L_C,
     L_CLAMP,
@@ -35,7 +36,6 @@ from tailbeam.solvers.stream.cheb_events import (
     illinois_point,
     illinois_update,
 )
-from tailbeam.solvers.stream.jit import helper_njit
 
 
 @helper_njit

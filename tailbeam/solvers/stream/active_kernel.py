@@ -5,7 +5,7 @@ One call advances the state from t until the first structural event or t_stop (s
 and every watched row (pairs and edges: O(pairs watched + balls)) certified in three tiers:
 the bound B on how far each state component moves in the step, else the 15 Chebyshev values
 of the row, else the first-crossing search (``active_events``). Helpers take arrays one by one
-and are compiled without reference counting (``tailbeam.solvers.stream.jit``); only
+and are compiled without reference counting (``tailbeam.solvers.jit``); only
 ``advance`` and ``_workspaces`` allocate. Modules: the step and its dense output
 (``active_step``), the event search (``active_events``), and here the loop and its
 bookkeeping (peaks, force rows, applying events, settling).
@@ -33,6 +33,7 @@ import math
 import numpy as np
 from numba import njit
 
+from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.records import EventKind
 from tailbeam.solvers.rigid.dop853 import growth, shrink
 from tailbeam.solvers.stream.active_events import detect, prepare
@@ -60,7 +61,6 @@ from tailbeam.solvers.stream.active_step import (
     project_plate,
 )
 from tailbeam.solvers.stream.cheb_events import interpolant_max
-from tailbeam.solvers.stream.jit import helper_njit
 
 # return status of ``advance``
 ST_STOP, ST_START, ST_END, ST_LEAVE, ST_SETTLE, ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = range(8)

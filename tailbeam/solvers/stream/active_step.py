@@ -8,15 +8,15 @@ ball and step), and with the modal plate the modes projected on a plate pair's p
 (``project``, ``project_plate``, ``ensure_plate``: O(modes) per pair and step, not per point).
 State layout (``active_kernel.advance``): positions (3 n, m), velocities (3 n, m/s), then the
 modal coordinates (m) and their rates. Helpers compiled without reference counting
-(``tailbeam.solvers.stream.jit``).
+(``tailbeam.solvers.jit``).
 """
 
 import math
 
 import numpy as np
 
+from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.stream.active_pairs import rhs, rhs_arrays
-from tailbeam.solvers.stream.jit import helper_njit
 
 EPS = 2.220446049250313e-16
 
