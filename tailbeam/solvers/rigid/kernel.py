@@ -115,6 +115,19 @@ def _watch_step(y0, y1, n0, n1, coef, ramp, clamped, par, fresh_w, direction, G,
 
 
 @helper_njit
+def _root_in(w, q, dirn, fresh, G, y0, y1, coef, ramp, clamped, par, buf, xtol):
+    """Root (fraction of the step) of watched function w in the q-th quarter of the step
+    (values at its ends: G[q, w], G[q + 1, w]) if it crosses there in direction dirn (+1 up,
+    -1 down), else -1; fresh: w is the restart function (``regions.find_root``)."""
+    xa = 0.0 if q == 0 else INTERIOR[q - 1]
+    xb = INTERIOR[q] if q < 3 else 1.0
+    va, vb = G[q, w], G[q + 1, w]
+    if not crosses(va, vb, dirn):
+        return -1.0
+    return find_root(w, xa, va, xb, vb, fresh, y0, y1, coef, ramp, clamped, par, buf, xtol)
+
+
+@helper_njit
 def _first_kink(active, direction, G, fresh_w, y0, y1, coef, ramp, clamped, par, buf, xtol):
     """Earliest crossing (x_sw, w_sw) in the step of a terminal watched function (kinks,
     separation, rest): x_sw in [0, 1] of the step, w_sw = -1 (x_sw = 2) if none."""
@@ -123,19 +136,15 @@ def _first_kink(active, direction, G, fresh_w, y0, y1, coef, ramp, clamped, par,
     for w in range(4):
         if not active[w]:
             continue
-        xa, va = 0.0, G[0, w]
         for q in range(4):
-            xb = INTERIOR[q] if q < 3 else 1.0
-            vb = G[q + 1, w]
-            if xa >= x_sw:
+            if (0.0 if q == 0 else INTERIOR[q - 1]) >= x_sw:
                 break
-            if crosses(va, vb, direction[w]):
-                xr = find_root(w, xa, va, xb, vb, fresh_w == w, y0, y1, coef, ramp, clamped,
-                               par, buf, xtol)  # fmt: skip
+            xr = _root_in(w, q, direction[w], fresh_w == w, G, y0, y1, coef, ramp, clamped, par,
+                          buf, xtol)  # fmt: skip
+            if xr >= 0.0:
                 if xr < x_sw:
                     x_sw, w_sw = xr, w
                 break
-            xa, va = xb, vb
     return x_sw, w_sw
 
 
@@ -148,23 +157,17 @@ def _maxima(active, G, x_end, tau, h, y0, y1, coef, ramp, clamped, par, buf, xto
     for w in (W_UMAX, W_PEAK):
         if not active[w]:
             continue
-        xa, va = 0.0, G[0, w]
         for q in range(4):
-            xb = INTERIOR[q] if q < 3 else 1.0
-            vb = G[q + 1, w]
-            if xa >= x_end:
+            if (0.0 if q == 0 else INTERIOR[q - 1]) >= x_end:
                 break
-            if crosses(va, vb, -1.0):
-                xr = find_root(w, xa, va, xb, vb, False, y0, y1, coef, ramp, clamped, par,
-                               buf, xtol)  # fmt: skip
-                if xr <= x_end:
-                    dl, uq = dense_eval(xr, y0, y1, coef)
-                    fr = watch_all(dl, uq, ramp, clamped, par, buf)
-                    if w == W_UMAX:
-                        pen = max(pen, dl)
-                    elif fr > peak:
-                        peak, tau_peak = fr, tau + xr * h
-            xa, va = xb, vb
+            xr = _root_in(w, q, -1.0, False, G, y0, y1, coef, ramp, clamped, par, buf, xtol)
+            if 0.0 <= xr <= x_end:
+                dl, uq = dense_eval(xr, y0, y1, coef)
+                fr = watch_all(dl, uq, ramp, clamped, par, buf)
+                if w == W_UMAX:
+                    pen = max(pen, dl)
+                elif fr > peak:
+                    peak, tau_peak = fr, tau + xr * h
     _update_maxima(res, force_a, tau, y0, pen, peak, tau_peak)
 
 
