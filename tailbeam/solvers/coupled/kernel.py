@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from tailbeam.solvers.coupled.step import CLAMPED, CONTACT, FLIGHT, solve_step
+from tailbeam.solvers.jit import helper_njit
 
 EV_NONE, EV_START, EV_END, EV_DEEP, EV_SHALLOW, EV_CLAMP_ON, EV_CLAMP_OFF = range(7)
 ST_STOP, ST_EVENT, ST_FULL, ST_FAIL, ST_STEPS = range(5)
@@ -167,7 +168,7 @@ def _certify(b, tau, ctx, st, out, g, L, A, gap0, rate0, guess):
     return -1.0, 0.0, 0.0, 0.0
 
 
-@njit(cache=True, inline="always")
+@helper_njit
 def _pending_event(F, mode, deep, cur, d, clampf):
     """Apply the first event that happened at the same instant as the one that ended the
     previous run (found in the step-end quantities ``cur``): (kind, ball), or EV_NONE."""
@@ -195,7 +196,7 @@ def _pending_event(F, mode, deep, cur, d, clampf):
     return EV_NONE, -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _flight_step(ctx, st, remaining, h, g, fm):
     """Step (s) with no ball in contact: the certified horizon before any flying ball can
     touch (from the bounds of ``_bounds`` on the gap), at least its h, at most remaining."""
@@ -227,29 +228,29 @@ def _flight_step(ctx, st, remaining, h, g, fm):
     return tau
 
 
-@njit(cache=True, inline="always")
-def _step_length(ctx, st, mode, remaining, h, g, fm):
-    """Next step (s): the smallest contact step h[b] of the balls in contact, else the
-    certified flight horizon (``_flight_step``); at most remaining."""
+@helper_njit
+def _contact_step(mode, remaining, h):
+    """(whether a ball is in contact, the smallest contact step h[b] (s) of those balls, at
+    most remaining)."""
     in_contact = False
     for b in range(mode.shape[0]):
         if mode[b] == CONTACT or mode[b] == CLAMPED:
             in_contact = True
+    tau = remaining
     if in_contact:
-        tau = remaining
         for b in range(mode.shape[0]):
             if mode[b] == CONTACT or mode[b] == CLAMPED:
                 tau = min(tau, h[b])
-    else:
-        tau = _flight_step(ctx, st, remaining, h, g, fm)
-    return min(tau, remaining)
+    return in_contact, tau
 
 
-@njit(cache=True, inline="always")
+@helper_njit
 def _contact_kinds(b, mode, deep, aux, d, clampf, kinds):
     """The events of touching ball b whose function changed sign over the step (step-end
-    quantities aux) into kinds; returns their number."""
+    quantities aux) into kinds; returns their number (0 if b is not touching)."""
     nk = 0
+    if not (mode[b] == CONTACT or mode[b] == CLAMPED):
+        return nk
     if aux[0, b] < 0.0:
         kinds[nk] = EV_END
         nk += 1
@@ -265,7 +266,7 @@ def _contact_kinds(b, mode, deep, aux, d, clampf, kinds):
     return nk
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _keep(hit, kd, b, best, kind_best, b_best, out2, out_best):
     """Keep event kd of ball b at hit (s) (solution in out2) if it is the earliest so far."""
     if hit < best or kind_best == EV_NONE:
@@ -274,14 +275,14 @@ def _keep(hit, kd, b, best, kind_best, b_best, out2, out_best):
     return best, kind_best, b_best
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kind_best, b_best,
-                 mode, deep, cur, d, clampf):  # fmt: skip
-    """Locate the events of ball b in the step of tau (s) and keep the earliest of all
-    (``_keep``); returns (ok, best, kind_best, b_best), ok False if a step solve failed."""
+                 mode, cur, d, kinds, nk):  # fmt: skip
+    """Locate the events of ball b in the step of tau (s) (touching: the nk kinds found by
+    ``_contact_kinds``; flying: a contact start) and keep the earliest of all (``_keep``);
+    returns (ok, best, kind_best, b_best), ok False if a step solve failed."""
     if mode[b] == CONTACT or mode[b] == CLAMPED:
-        kinds = np.zeros(4, dtype=np.int64)
-        for kk in range(_contact_kinds(b, mode, deep, aux, d, clampf, kinds)):
+        for kk in range(nk):
             kd = kinds[kk]
             f_lo = _event_value(kd, b, cur, d)
             f_hi = _event_value(kd, b, aux, d)
@@ -306,7 +307,7 @@ def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kin
     return True, best, kind_best, b_best
 
 
-@njit(cache=True, inline="always")
+@helper_njit
 def _accept(q, qd, z, vz, F, mode, cur, hist, q1, qd1, z1, vz1, F1, aux, tau):
     """Take the step of tau (s) (ending in q1, .., aux) as the new state (q, .., cur), and the
     BDF2 force history hist."""
@@ -317,26 +318,30 @@ def _accept(q, qd, z, vz, F, mode, cur, hist, q1, qd1, z1, vz1, F1, aux, tau):
         else:
             hist[0, b] = 0.0
             hist[1, b] = 0.0
-    q[:] = q1
-    qd[:] = qd1
-    z[:] = z1
-    vz[:] = vz1
-    F[:] = F1
-    cur[:, :] = aux
+    for i in range(q.shape[0]):
+        q[i] = q1[i]
+        qd[i] = qd1[i]
+    for b in range(z.shape[0]):
+        z[b] = z1[b]
+        vz[b] = vz1[b]
+        F[b] = F1[b]
+        for r in range(cur.shape[0]):
+            cur[r, b] = aux[r, b]
 
 
-@njit(cache=True, inline="always")
+@helper_njit
 def _record(bt, bz, bvz, bF, bd, nbuf, t, z, vz, F, cur):
     """Write node nbuf of the buffers: t (s), heights z (m), speeds vz (m/s), forces F (N),
     penetrations delta (m)."""
     bt[nbuf] = t
-    bz[nbuf, :] = z
-    bvz[nbuf, :] = vz
-    bF[nbuf, :] = F
-    bd[nbuf, :] = cur[0]
+    for b in range(z.shape[0]):
+        bz[nbuf, b] = z[b]
+        bvz[nbuf, b] = vz[b]
+        bF[nbuf, b] = F[b]
+        bd[nbuf, b] = cur[0, b]
 
 
-@njit(cache=True, inline="always")
+@helper_njit
 def _apply_event(kind, b, F, mode, deep, cur, hist, d):
     """Change ball b's mode for the event kind located at the step's end (st accepted)."""
     if kind == EV_START:
@@ -373,6 +378,7 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
     q1, qd1, z1, vz1, F1, aux, _coef, f0m, f1m = out
     guess = np.empty(nb)
     fm = np.empty(n)
+    kinds = np.zeros(4, dtype=np.int64)  # events of one ball in a step
     evout[0], evout[1] = _pending_event(F, mode, deep, cur, d, clampf)
     if evout[0] != EV_NONE:
         return ST_EVENT, t, nbuf, 0
@@ -383,7 +389,10 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
         if steps >= max_steps:
             return ST_STEPS, t, nbuf, steps
         steps += 1
-        tau = _step_length(ctx, st, mode, t_stop - t, h, g, fm)
+        in_contact, tau = _contact_step(mode, t_stop - t, h)
+        if not in_contact:  # the certified flight horizon
+            tau = _flight_step(ctx, st, t_stop - t, h, g, fm)
+        tau = min(tau, t_stop - t)
         for b in range(nb):
             guess[b] = F[b] + hist[0, b] * tau
             F1[b] = guess[b]
@@ -393,9 +402,12 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
         best, kind_best, b_best = tau, EV_NONE, -1
         L, A = _bounds(ctx, st, f0m, f1m, tau, g)
         for b in range(nb):
+            nk = _contact_kinds(b, mode, deep, aux, d, clampf, kinds)
+            if nk == 0 and mode[b] != FLIGHT:
+                continue  # (nothing to locate: no tuples handed over, see tailbeam.solvers.jit)
             ok, best, kind_best, b_best = _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L,
                                                        A, guess, best, kind_best, b_best, mode,
-                                                       deep, cur, d, clampf)  # fmt: skip
+                                                       cur, d, kinds, nk)  # fmt: skip
             if not ok:
                 return ST_FAIL, t, nbuf, steps
         if kind_best != EV_NONE:

@@ -19,21 +19,27 @@ from numba import njit
 
 from tailbeam.physics.impact import force_partials
 from tailbeam.solvers.coupled.propagator import A1, B1, advance, coefficients
+from tailbeam.solvers.jit import helper_njit
 
 FLIGHT, CONTACT, CLAMPED, REST, OFF = 0, 1, 2, 3, 4
 
 
-@njit(cache=True, inline="always")
+@helper_njit
 def _modal_loads(phi, mass, F, mode, g, f0m, f1m):
     """Modal forces (N) at the step's start f0m (the contact forces F) and end f1m (the
     resting balls' weights only: the contact end forces are still unknown)."""
-    f0m[:] = 0.0
-    f1m[:] = 0.0
+    n = phi.shape[1]
+    for i in range(n):
+        f0m[i] = 0.0
+        f1m[i] = 0.0
     for b in range(phi.shape[0]):
         if F[b] != 0.0:
-            f0m -= phi[b] * F[b]
+            for i in range(n):
+                f0m[i] -= phi[b, i] * F[b]
         if mode[b] == REST:
-            f1m -= phi[b] * (mass[b] * g)
+            w = mass[b] * g
+            for i in range(n):
+                f1m[i] -= phi[b, i] * w
 
 
 @njit(cache=True, inline="always")
@@ -108,7 +114,7 @@ def _newton(idx, na, dfree, vfree, S, Sv, x, k, e, c, d, clampf):
     return False
 
 
-@njit(cache=True, inline="always")
+@helper_njit
 def _ball_ends(tau, phi, cres, mass, radius, k, e, c, d, z, vz, F, mode, hist, q1, qd1, z1, vz1,
                F1, aux, g):  # fmt: skip
     """Balls at the step's end (heights z1 m, speeds vz1 m/s, cubic in time under the linear
