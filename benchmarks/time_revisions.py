@@ -16,8 +16,8 @@ Each tree runs in its own process with its own numba cache (compiled and run onc
 timed), then the timed runs with ``time.process_time`` (CPU time: less sensitive than the
 wall clock to other processes on a shared machine); prints best and median per tree and
 round, and the wall time of the first call (numba compiles then: round 1 only, the cache
-is warm in later rounds). The trees alternate, so a change of machine load hits both. Same work in both trees is
-checked by the count printed.
+is warm in later rounds). The trees alternate, so a change of machine load hits both. Same
+work in both trees is checked by the count printed.
 """
 
 import argparse
