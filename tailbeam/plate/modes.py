@@ -309,6 +309,23 @@ def compute_modes(
         hit = _from_cache(path, key, plate, boundary, res, accuracy, mindlin_degree)
         if hit is not None:
             return hit
+    request = (fmax_hz, count, accuracy, mindlin_degree)
+    model, freqs, phi, info = _solve_fresh(plate, boundary, res, mesh, mesh_obj, request,
+                                           blas_threads)  # fmt: skip
+    info.update(cache="off" if not use_cache else "miss")
+    info.update(cache_file=str(path) if use_cache else None)
+    if use_cache:
+        _store(path, key, freqs, phi, model, mesh_obj, info)
+    return _make_basis(plate, boundary, res.theory, freqs, phi, model.free_dofs, model.n_full,
+                       mesh_obj, info, degree=mindlin_degree, model=model,
+                       shared_key=key if use_cache else None,
+                       probe_basis=model.deflection_basis)  # fmt: skip
+
+
+def _solve_fresh(plate, boundary, res, mesh, mesh_obj, request, blas_threads):
+    """Assemble the FE model and solve its band (no cache): (model, frequencies Hz, signed
+    free-DOF mode shapes, info). request = (fmax_hz, count, accuracy, mindlin_degree)."""
+    fmax_hz, count, accuracy, mindlin_degree = request
     cost = _solve_cost(plate, boundary, res, mesh_obj, fmax_hz, count, mindlin_degree)
     threads = _blas_threads(blas_threads)
     with threadpool_limits(limits=threads):
@@ -326,7 +343,6 @@ def compute_modes(
             f"no mode lies below {fmax_hz!r} Hz for boundary "
             f"{boundary!r} (the plate's lowest elastic mode is higher)",
         )
-    phi = _signed(phi)
     info = _describe(plate, boundary, res, model, mesh, mesh_obj, fmax_hz, count, accuracy)
     info.update(
         {
@@ -334,27 +350,9 @@ def compute_modes(
             "eigensolve_s": t2 - t1,
             "blas_threads": threads,
             "cost_estimate": cost.as_dict(),
-            "cache": "off" if not use_cache else "miss",
-            "cache_file": str(path) if use_cache else None,
         }
     )
-    if use_cache:
-        _store(path, key, freqs, phi, model, mesh_obj, info)
-    return _make_basis(
-        plate,
-        boundary,
-        res.theory,
-        freqs,
-        phi,
-        model.free_dofs,
-        model.n_full,
-        mesh_obj,
-        info,
-        degree=mindlin_degree,
-        model=model,
-        shared_key=key if use_cache else None,
-        probe_basis=model.deflection_basis,
-    )
+    return model, freqs, _signed(phi), info
 
 
 def _signed(phi: np.ndarray) -> np.ndarray:
