@@ -5,7 +5,7 @@ tailbeam.modal.ModalBasis, from the FE models, with automatic theory/mesh choice
 import os
 import time
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from numbers import Integral
 
 import numpy as np
@@ -167,6 +167,7 @@ class FEModalBasis(ModalBasis):
 
 _SHARED_STATES: "OrderedDict[str, dict]" = OrderedDict()
 SHARED_MODELS = 2  # assembled FE models kept per process (each ~tens of MB with its LU)
+_LOADED: "OrderedDict[tuple, FEModalBasis]" = OrderedDict()  # bases read from the cache
 
 
 def _shared_state(key, model, degree) -> dict:
@@ -239,26 +240,39 @@ def _make_basis(
 
 
 def _from_cache(path, key, plate, boundary, res, accuracy, degree):
-    """The cached basis at ``path`` (None on a miss or a damaged entry)."""
-    hit = modal_cache.load(path, key)
-    if hit is None:
+    """The cached basis at ``path`` (None on a miss or a damaged entry). A file this process
+    already read (same size and modification time) is not read again: its basis is reused
+    with this request's ``info`` (a sweep's worker runs many cases on one basis)."""
+    try:
+        stat = os.stat(path)
+    except OSError:
         return None
-    freqs, vectors, free_dofs, n_full, cached_mesh, info = hit
+    memo_key = (str(path), key, stat.st_mtime_ns, stat.st_size)
+    basis = _LOADED.pop(memo_key, None)
+    if basis is None:
+        hit = modal_cache.load(path, key)
+        if hit is None:
+            return None
+        freqs, vectors, free_dofs, n_full, cached_mesh, info = hit
+        basis = _make_basis(
+            plate,
+            boundary,
+            res.theory,
+            freqs,
+            vectors,
+            free_dofs,
+            n_full,
+            cached_mesh,
+            info,
+            degree=degree,
+            shared_key=key,
+        )
+    _LOADED[memo_key] = basis
+    while len(_LOADED) > SHARED_MODELS:
+        _LOADED.popitem(last=False)
     # same physics and mesh; the request that led here may differ (e.g. accuracy)
-    info.update(cache="hit", cache_file=str(path), reason=res.reason, accuracy=accuracy)
-    return _make_basis(
-        plate,
-        boundary,
-        res.theory,
-        freqs,
-        vectors,
-        free_dofs,
-        n_full,
-        cached_mesh,
-        info,
-        degree=degree,
-        shared_key=key,
-    )
+    info = {**basis.info, "cache": "hit", "cache_file": str(path), "reason": res.reason}
+    return replace(basis, info={**info, "accuracy": accuracy})
 
 
 def compute_modes(
