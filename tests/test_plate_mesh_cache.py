@@ -109,6 +109,22 @@ def test_cache_reload_equals_computed_and_is_fast(tmp_path):
     assert other.info["cache"] == "miss" and other.n_modes < cold.n_modes
 
 
+def test_a_process_reads_a_cache_file_once_and_again_when_it_changes(tmp_path):
+    kw = dict(theory="kirchhoff", fmax_hz=2000.0, divisions=6, cache_dir=tmp_path)
+    compute_modes(PLATE, "SSSS", **kw)  # computed and stored (a miss)
+    first = compute_modes(PLATE, "SSSS", **kw, accuracy=0.02)
+    second = compute_modes(PLATE, "SSSS", **kw, accuracy=0.03)
+    assert first.info["cache"] == second.info["cache"] == "hit"
+    assert second.mode_vectors is first.mode_vectors  # read once: the same arrays
+    assert (first.info["accuracy"], second.info["accuracy"]) == (0.02, 0.03)  # own info
+    path = first.info["cache_file"]
+    with open(path, "wb") as fh:  # replaced on disk (size and time change): read again
+        fh.write(b"not a zip file")
+    again = compute_modes(PLATE, "SSSS", **kw)
+    assert again.info["cache"] == "miss"
+    np.testing.assert_array_equal(again.frequencies_hz, first.frequencies_hz)
+
+
 def test_every_input_changes_the_cache_key():
     mesh = structured_mesh(PLATE, 4)
     base = dict(

@@ -5,7 +5,7 @@ tailbeam.modal.ModalBasis, from the FE models, with automatic theory/mesh choice
 import os
 import time
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from numbers import Integral
 
 import numpy as np
@@ -167,6 +167,7 @@ class FEModalBasis(ModalBasis):
 
 _SHARED_STATES: "OrderedDict[str, dict]" = OrderedDict()
 SHARED_MODELS = 2  # assembled FE models kept per process (each ~tens of MB with its LU)
+_LOADED: "OrderedDict[tuple, FEModalBasis]" = OrderedDict()  # bases read from the cache
 
 
 def _shared_state(key, model, degree) -> dict:
@@ -239,26 +240,39 @@ def _make_basis(
 
 
 def _from_cache(path, key, plate, boundary, res, accuracy, degree):
-    """The cached basis at ``path`` (None on a miss or a damaged entry)."""
-    hit = modal_cache.load(path, key)
-    if hit is None:
+    """The cached basis at ``path`` (None on a miss or a damaged entry). A file this process
+    already read (same size and modification time) is not read again: its basis is reused
+    with this request's ``info`` (a sweep's worker runs many cases on one basis)."""
+    try:
+        stat = os.stat(path)
+    except OSError:
         return None
-    freqs, vectors, free_dofs, n_full, cached_mesh, info = hit
+    memo_key = (str(path), key, stat.st_mtime_ns, stat.st_size)
+    basis = _LOADED.pop(memo_key, None)
+    if basis is None:
+        hit = modal_cache.load(path, key)
+        if hit is None:
+            return None
+        freqs, vectors, free_dofs, n_full, cached_mesh, info = hit
+        basis = _make_basis(
+            plate,
+            boundary,
+            res.theory,
+            freqs,
+            vectors,
+            free_dofs,
+            n_full,
+            cached_mesh,
+            info,
+            degree=degree,
+            shared_key=key,
+        )
+    _LOADED[memo_key] = basis
+    while len(_LOADED) > SHARED_MODELS:
+        _LOADED.popitem(last=False)
     # same physics and mesh; the request that led here may differ (e.g. accuracy)
-    info.update(cache="hit", cache_file=str(path), reason=res.reason, accuracy=accuracy)
-    return _make_basis(
-        plate,
-        boundary,
-        res.theory,
-        freqs,
-        vectors,
-        free_dofs,
-        n_full,
-        cached_mesh,
-        info,
-        degree=degree,
-        shared_key=key,
-    )
+    info = {**basis.info, "cache": "hit", "cache_file": str(path), "reason": res.reason}
+    return replace(basis, info={**info, "accuracy": accuracy})
 
 
 def compute_modes(
@@ -309,6 +323,23 @@ def compute_modes(
         hit = _from_cache(path, key, plate, boundary, res, accuracy, mindlin_degree)
         if hit is not None:
             return hit
+    request = (fmax_hz, count, accuracy, mindlin_degree)
+    model, freqs, phi, info = _solve_fresh(plate, boundary, res, mesh, mesh_obj, request,
+                                           blas_threads)  # fmt: skip
+    info.update(cache="off" if not use_cache else "miss")
+    info.update(cache_file=str(path) if use_cache else None)
+    if use_cache:
+        _store(path, key, freqs, phi, model, mesh_obj, info)
+    return _make_basis(plate, boundary, res.theory, freqs, phi, model.free_dofs, model.n_full,
+                       mesh_obj, info, degree=mindlin_degree, model=model,
+                       shared_key=key if use_cache else None,
+                       probe_basis=model.deflection_basis)  # fmt: skip
+
+
+def _solve_fresh(plate, boundary, res, mesh, mesh_obj, request, blas_threads):
+    """Assemble the FE model and solve its band (no cache): (model, frequencies Hz, signed
+    free-DOF mode shapes, info). request = (fmax_hz, count, accuracy, mindlin_degree)."""
+    fmax_hz, count, accuracy, mindlin_degree = request
     cost = _solve_cost(plate, boundary, res, mesh_obj, fmax_hz, count, mindlin_degree)
     threads = _blas_threads(blas_threads)
     with threadpool_limits(limits=threads):
@@ -326,7 +357,6 @@ def compute_modes(
             f"no mode lies below {fmax_hz!r} Hz for boundary "
             f"{boundary!r} (the plate's lowest elastic mode is higher)",
         )
-    phi = _signed(phi)
     info = _describe(plate, boundary, res, model, mesh, mesh_obj, fmax_hz, count, accuracy)
     info.update(
         {
@@ -334,27 +364,9 @@ def compute_modes(
             "eigensolve_s": t2 - t1,
             "blas_threads": threads,
             "cost_estimate": cost.as_dict(),
-            "cache": "off" if not use_cache else "miss",
-            "cache_file": str(path) if use_cache else None,
         }
     )
-    if use_cache:
-        _store(path, key, freqs, phi, model, mesh_obj, info)
-    return _make_basis(
-        plate,
-        boundary,
-        res.theory,
-        freqs,
-        phi,
-        model.free_dofs,
-        model.n_full,
-        mesh_obj,
-        info,
-        degree=mindlin_degree,
-        model=model,
-        shared_key=key if use_cache else None,
-        probe_basis=model.deflection_basis,
-    )
+    return model, freqs, _signed(phi), info
 
 
 def _signed(phi: np.ndarray) -> np.ndarray:

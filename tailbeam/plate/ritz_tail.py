@@ -59,14 +59,15 @@ def krylov_tail(basis, loads) -> "KrylovTail":
     return _remember(_KRYLOV, key, basis, lambda: KrylovTail(basis, loads))
 
 
-def _remember(store: dict, key, basis, build):
-    """``store[key]``'s value if it was built for this very ``basis`` (ids are reused once a
-    basis is gone), else ``build()`` kept there; the store holds the last KRYLOV_MEMO."""
+def _remember(store: dict, key, owner, build):
+    """``store[key]``'s value if it was built for this very ``owner`` object (ids are reused
+    once an object is gone), else ``build()`` kept there; the store holds the last
+    KRYLOV_MEMO."""
     hit = store.get(key)
-    if hit is None or hit[0] is not basis:
+    if hit is None or hit[0] is not owner:
         while len(store) >= KRYLOV_MEMO:
             store.pop(next(iter(store)))
-        hit = store[key] = (basis, build())
+        hit = store[key] = (owner, build())
     return hit[1]
 
 
@@ -131,14 +132,14 @@ class KrylovTail:
         return np.sqrt(theta), V @ Y
 
 
-_MASS_KEPT: dict = {}  # id(basis) -> (basis, M Phi_kept), the last KRYLOV_MEMO bases
+_MASS_KEPT: dict = {}  # id(Phi_kept) -> (Phi_kept, M Phi_kept), the last KRYLOV_MEMO
 
 
 def _mass_kept(basis) -> np.ndarray:
-    """M Phi_kept (n_dofs, modes) of ``basis``, computed once per basis (a sweep's cases share
-    it)."""
-    return _remember(_MASS_KEPT, id(basis), basis,
-                     lambda: basis.fe_model().mass @ basis.mode_vectors)  # fmt: skip
+    """M Phi_kept (n_dofs, modes) of ``basis``, computed once per set of kept modes (a sweep's
+    cases share the bases read from the cache, tailbeam.plate.modes._from_cache)."""
+    kept = basis.mode_vectors
+    return _remember(_MASS_KEPT, id(kept), kept, lambda: basis.fe_model().mass @ kept)
 
 
 def with_ritz_tail(basis, points, contact_radius: float = 0.0, k: int = 32) -> ModalBasis:

@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from tailbeam.solvers.coupled.step import CLAMPED, CONTACT, FLIGHT, solve_step
+from tailbeam.solvers.jit import helper_njit
 
 EV_NONE, EV_START, EV_END, EV_DEEP, EV_SHALLOW, EV_CLAMP_ON, EV_CLAMP_OFF = range(7)
 ST_STOP, ST_EVENT, ST_FULL, ST_FAIL, ST_STEPS = range(5)
@@ -167,6 +168,201 @@ def _certify(b, tau, ctx, st, out, g, L, A, gap0, rate0, guess):
     return -1.0, 0.0, 0.0, 0.0
 
 
+@helper_njit
+def _pending_event(F, mode, deep, cur, d, clampf):
+    """Apply the first event that happened at the same instant as the one that ended the
+    previous run (found in the step-end quantities ``cur``): (kind, ball), or EV_NONE."""
+    for b in range(mode.shape[0]):
+        touching = mode[b] == CONTACT or mode[b] == CLAMPED
+        if mode[b] == FLIGHT and cur[0, b] >= 0.0:
+            mode[b] = CONTACT
+            deep[b] = cur[0, b] > d[b]
+            return EV_START, b
+        elif touching and cur[0, b] < 0.0:
+            mode[b] = FLIGHT
+            F[b] = 0.0
+            deep[b] = False
+            return EV_END, b
+        elif touching and (cur[0, b] > d[b]) != deep[b]:
+            kd = EV_SHALLOW if deep[b] else EV_DEEP
+            deep[b] = not deep[b]
+            return kd, b
+        elif clampf[b] and mode[b] == CONTACT and cur[2, b] < 0.0:
+            mode[b] = CLAMPED
+            return EV_CLAMP_ON, b
+        elif clampf[b] and mode[b] == CLAMPED and cur[2, b] > 0.0:
+            mode[b] = CONTACT
+            return EV_CLAMP_OFF, b
+    return EV_NONE, -1
+
+
+@njit(cache=True)
+def _flight_step(ctx, st, remaining, h, g, fm):
+    """Step (s) with no ball in contact: the certified horizon before any flying ball can
+    touch (from the bounds of ``_bounds`` on the gap), at least its h, at most remaining."""
+    phi = ctx[2]
+    _q, _qd, _z, _vz, F, mode, _deep, cur, _hist = st
+    nb = phi.shape[0]
+    fm[:] = 0.0
+    for b in range(nb):
+        if F[b] != 0.0:
+            fm -= phi[b] * F[b]
+    L, A = _bounds(ctx, st, fm, fm, 0.0, g)
+    tau = remaining
+    for b in range(nb):
+        if mode[b] != FLIGHT:
+            continue
+        gap = -cur[0, b]
+        rate = cur[3, b]
+        V = L[b]
+        t1 = 2.0 * gap / (V + math.sqrt(V * V + 4.0 * g * gap))
+        at = g + A[b]
+        root = math.sqrt(max(rate * rate + 2.0 * at * gap, 0.0))
+        if rate < 0.0:
+            t2 = 2.0 * gap / (root - rate)  # stable form while approaching
+        elif at > 0.0:
+            t2 = (rate + root) / at
+        else:
+            t2 = remaining
+        tau = min(tau, max(max(t1, t2) * (1.0 - 1e-9), h[b]))
+    return tau
+
+
+@helper_njit
+def _contact_step(mode, remaining, h):
+    """(whether a ball is in contact, the smallest contact step h[b] (s) of those balls, at
+    most remaining)."""
+    in_contact = False
+    for b in range(mode.shape[0]):
+        if mode[b] == CONTACT or mode[b] == CLAMPED:
+            in_contact = True
+    tau = remaining
+    if in_contact:
+        for b in range(mode.shape[0]):
+            if mode[b] == CONTACT or mode[b] == CLAMPED:
+                tau = min(tau, h[b])
+    return in_contact, tau
+
+
+@helper_njit
+def _contact_kinds(b, mode, deep, aux, d, clampf, kinds):
+    """The events of touching ball b whose function changed sign over the step (step-end
+    quantities aux) into kinds; returns their number (0 if b is not touching)."""
+    nk = 0
+    if not (mode[b] == CONTACT or mode[b] == CLAMPED):
+        return nk
+    if aux[0, b] < 0.0:
+        kinds[nk] = EV_END
+        nk += 1
+    if (aux[0, b] > d[b]) != deep[b]:
+        kinds[nk] = EV_SHALLOW if deep[b] else EV_DEEP
+        nk += 1
+    if clampf[b] and mode[b] == CONTACT and aux[2, b] < 0.0:
+        kinds[nk] = EV_CLAMP_ON
+        nk += 1
+    if clampf[b] and mode[b] == CLAMPED and aux[2, b] > 0.0:
+        kinds[nk] = EV_CLAMP_OFF
+        nk += 1
+    return nk
+
+
+@njit(cache=True)
+def _keep(hit, kd, b, best, kind_best, b_best, out2, out_best):
+    """Keep event kd of ball b at hit (s) (solution in out2) if it is the earliest so far."""
+    if hit < best or kind_best == EV_NONE:
+        _copy_out(out2, out_best)
+        return hit, kd, b
+    return best, kind_best, b_best
+
+
+@njit(cache=True)
+def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kind_best, b_best,
+                 mode, cur, d, kinds, nk):  # fmt: skip
+    """Locate the events of ball b in the step of tau (s) (touching: the nk kinds found by
+    ``_contact_kinds``; flying: a contact start) and keep the earliest of all (``_keep``);
+    returns (ok, best, kind_best, b_best), ok False if a step solve failed."""
+    if mode[b] == CONTACT or mode[b] == CLAMPED:
+        for kk in range(nk):
+            kd = kinds[kk]
+            f_lo = _event_value(kd, b, cur, d)
+            f_hi = _event_value(kd, b, aux, d)
+            if f_lo == 0.0:
+                f_lo = -f_hi * 1e-30
+            hit = _locate(kd, b, 0.0, f_lo, tau, f_hi, ctx, st, out2, g, d, guess)
+            if hit < 0.0:
+                return False, best, kind_best, b_best
+            best, kind_best, b_best = _keep(hit, kd, b, best, kind_best, b_best, out2, out_best)
+    elif mode[b] == FLIGHT:
+        lo, hi, flo, fhi = _certify(b, tau, ctx, st, out2, g, L, A, -cur[0, b], cur[3, b], guess)
+        if lo == -2.0:
+            return False, best, kind_best, b_best
+        if lo >= 0.0:
+            if flo == 0.0:
+                flo = 1e-300
+            hit = _locate(EV_START, b, lo, flo, hi, fhi, ctx, st, out2, g, d, guess)
+            if hit < 0.0:
+                return False, best, kind_best, b_best
+            best, kind_best, b_best = _keep(hit, EV_START, b, best, kind_best, b_best, out2,
+                                            out_best)  # fmt: skip
+    return True, best, kind_best, b_best
+
+
+@helper_njit
+def _accept(q, qd, z, vz, F, mode, cur, hist, q1, qd1, z1, vz1, F1, aux, tau):
+    """Take the step of tau (s) (ending in q1, .., aux) as the new state (q, .., cur), and the
+    BDF2 force history hist."""
+    for b in range(mode.shape[0]):
+        if mode[b] == CONTACT or mode[b] == CLAMPED:
+            hist[0, b] = (F1[b] - F[b]) / tau
+            hist[1, b] = tau
+        else:
+            hist[0, b] = 0.0
+            hist[1, b] = 0.0
+    for i in range(q.shape[0]):
+        q[i] = q1[i]
+        qd[i] = qd1[i]
+    for b in range(z.shape[0]):
+        z[b] = z1[b]
+        vz[b] = vz1[b]
+        F[b] = F1[b]
+        for r in range(cur.shape[0]):
+            cur[r, b] = aux[r, b]
+
+
+@helper_njit
+def _record(bt, bz, bvz, bF, bd, nbuf, t, z, vz, F, cur):
+    """Write node nbuf of the buffers: t (s), heights z (m), speeds vz (m/s), forces F (N),
+    penetrations delta (m)."""
+    bt[nbuf] = t
+    for b in range(z.shape[0]):
+        bz[nbuf, b] = z[b]
+        bvz[nbuf, b] = vz[b]
+        bF[nbuf, b] = F[b]
+        bd[nbuf, b] = cur[0, b]
+
+
+@helper_njit
+def _apply_event(kind, b, F, mode, deep, cur, hist, d):
+    """Change ball b's mode for the event kind located at the step's end (st accepted)."""
+    if kind == EV_START:
+        mode[b] = CONTACT
+        deep[b] = cur[0, b] > d[b]
+    elif kind == EV_END:
+        mode[b] = FLIGHT
+        F[b] = 0.0
+        deep[b] = False
+    elif kind == EV_DEEP or kind == EV_SHALLOW:
+        deep[b] = cur[0, b] > d[b]
+    elif kind == EV_CLAMP_ON:
+        mode[b] = CLAMPED
+    else:
+        mode[b] = CONTACT
+    if kind != EV_DEEP and kind != EV_SHALLOW:
+        # dF/dt jumps here (the STEP kink keeps it continuous): restart the BDF2 history
+        hist[0, b] = 0.0
+        hist[1, b] = 0.0
+
+
 @njit(cache=True)
 def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
     """Step from t until t_stop, the first event, a full buffer or max_steps.
@@ -174,43 +370,18 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
     Returns (status, t, nbuf, steps). bufs = (t, z, vz, F, delta) node buffers; evout[0:2] =
     (kind, ball) of the event that stopped the run.
     """
-    _om, _ze, phi, _cr, mass, _ra, _k, _e, _c, d, clampf = ctx
+    _om, _ze, phi, _cr, _mass, _ra, _k, _e, _c, d, clampf = ctx
     q, qd, z, vz, F, mode, deep, cur, hist = st
     bt, bz, bvz, bF, bd = bufs
     nb, n = phi.shape
-    out = _alloc(nb, n)
-    out2 = _alloc(nb, n)
-    out_best = _alloc(nb, n)
+    out, out2, out_best = _alloc(nb, n), _alloc(nb, n), _alloc(nb, n)
     q1, qd1, z1, vz1, F1, aux, _coef, f0m, f1m = out
     guess = np.empty(nb)
     fm = np.empty(n)
-    evout[0] = EV_NONE
-    evout[1] = -1
-    # events that happened at the same instant as the one that ended the previous run
-    for b in range(nb):
-        kd = EV_NONE
-        if mode[b] == FLIGHT and cur[0, b] >= 0.0:
-            kd = EV_START
-            mode[b] = CONTACT
-            deep[b] = cur[0, b] > d[b]
-        elif (mode[b] == CONTACT or mode[b] == CLAMPED) and cur[0, b] < 0.0:
-            kd = EV_END
-            mode[b] = FLIGHT
-            F[b] = 0.0
-            deep[b] = False
-        elif (mode[b] == CONTACT or mode[b] == CLAMPED) and (cur[0, b] > d[b]) != deep[b]:
-            kd = EV_SHALLOW if deep[b] else EV_DEEP
-            deep[b] = not deep[b]
-        elif clampf[b] and mode[b] == CONTACT and cur[2, b] < 0.0:
-            kd = EV_CLAMP_ON
-            mode[b] = CLAMPED
-        elif clampf[b] and mode[b] == CLAMPED and cur[2, b] > 0.0:
-            kd = EV_CLAMP_OFF
-            mode[b] = CONTACT
-        if kd != EV_NONE:
-            evout[0] = kd
-            evout[1] = b
-            return ST_EVENT, t, nbuf, 0
+    kinds = np.zeros(4, dtype=np.int64)  # events of one ball in a step
+    evout[0], evout[1] = _pending_event(F, mode, deep, cur, d, clampf)
+    if evout[0] != EV_NONE:
+        return ST_EVENT, t, nbuf, 0
     steps = 0
     while t < t_stop:
         if nbuf >= bt.shape[0]:
@@ -218,138 +389,38 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
         if steps >= max_steps:
             return ST_STEPS, t, nbuf, steps
         steps += 1
-        in_contact = False
-        for b in range(nb):
-            if mode[b] == CONTACT or mode[b] == CLAMPED:
-                in_contact = True
-        remaining = t_stop - t
-        if in_contact:
-            tau = remaining
-            for b in range(nb):
-                if mode[b] == CONTACT or mode[b] == CLAMPED:
-                    tau = min(tau, h[b])
-        else:
-            fm[:] = 0.0
-            for b in range(nb):
-                if F[b] != 0.0:
-                    fm -= phi[b] * F[b]
-            L, A = _bounds(ctx, st, fm, fm, 0.0, g)
-            tau = remaining
-            for b in range(nb):
-                if mode[b] != FLIGHT:
-                    continue
-                gap = -cur[0, b]
-                rate = cur[3, b]
-                V = L[b]
-                t1 = 2.0 * gap / (V + math.sqrt(V * V + 4.0 * g * gap))
-                at = g + A[b]
-                root = math.sqrt(max(rate * rate + 2.0 * at * gap, 0.0))
-                if rate < 0.0:
-                    t2 = 2.0 * gap / (root - rate)  # stable form while approaching
-                elif at > 0.0:
-                    t2 = (rate + root) / at
-                else:
-                    t2 = remaining
-                tau = min(tau, max(max(t1, t2) * (1.0 - 1e-9), h[b]))
-        tau = min(tau, remaining)
+        in_contact, tau = _contact_step(mode, t_stop - t, h)
+        if not in_contact:  # the certified flight horizon
+            tau = _flight_step(ctx, st, t_stop - t, h, g, fm)
+        tau = min(tau, t_stop - t)
         for b in range(nb):
             guess[b] = F[b] + hist[0, b] * tau
             F1[b] = guess[b]
         if not solve_step(tau, ctx, st, out, g):
             return ST_FAIL, t, nbuf, steps
         # --- events on this step: keep the earliest
-        best = tau
-        kind_best = EV_NONE
-        b_best = -1
+        best, kind_best, b_best = tau, EV_NONE, -1
         L, A = _bounds(ctx, st, f0m, f1m, tau, g)
         for b in range(nb):
-            kinds = np.zeros(4, dtype=np.int64)
-            nk = 0
-            if mode[b] == CONTACT or mode[b] == CLAMPED:
-                if aux[0, b] < 0.0:
-                    kinds[nk] = EV_END
-                    nk += 1
-                if (aux[0, b] > d[b]) != deep[b]:
-                    kinds[nk] = EV_SHALLOW if deep[b] else EV_DEEP
-                    nk += 1
-                if clampf[b] and mode[b] == CONTACT and aux[2, b] < 0.0:
-                    kinds[nk] = EV_CLAMP_ON
-                    nk += 1
-                if clampf[b] and mode[b] == CLAMPED and aux[2, b] > 0.0:
-                    kinds[nk] = EV_CLAMP_OFF
-                    nk += 1
-                for kk in range(nk):
-                    kd = kinds[kk]
-                    f_lo = _event_value(kd, b, cur, d)
-                    f_hi = _event_value(kd, b, aux, d)
-                    if f_lo == 0.0:
-                        f_lo = -f_hi * 1e-30
-                    hit = _locate(kd, b, 0.0, f_lo, tau, f_hi, ctx, st, out2, g, d, guess)
-                    if hit < 0.0:
-                        return ST_FAIL, t, nbuf, steps
-                    if hit < best or kind_best == EV_NONE:
-                        best, kind_best, b_best = hit, kd, b
-                        _copy_out(out2, out_best)
-            elif mode[b] == FLIGHT:
-                lo, hi, flo, fhi = _certify(
-                    b, tau, ctx, st, out2, g, L, A, -cur[0, b], cur[3, b], guess
-                )
-                if lo == -2.0:
-                    return ST_FAIL, t, nbuf, steps
-                if lo >= 0.0:
-                    if flo == 0.0:
-                        flo = 1e-300
-                    hit = _locate(EV_START, b, lo, flo, hi, fhi, ctx, st, out2, g, d, guess)
-                    if hit < 0.0:
-                        return ST_FAIL, t, nbuf, steps
-                    if hit < best or kind_best == EV_NONE:
-                        best, kind_best, b_best = hit, EV_START, b
-                        _copy_out(out2, out_best)
+            nk = _contact_kinds(b, mode, deep, aux, d, clampf, kinds)
+            if nk == 0 and mode[b] != FLIGHT:
+                continue  # (nothing to locate: no tuples handed over, see tailbeam.solvers.jit)
+            ok, best, kind_best, b_best = _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L,
+                                                       A, guess, best, kind_best, b_best, mode,
+                                                       cur, d, kinds, nk)  # fmt: skip
+            if not ok:
+                return ST_FAIL, t, nbuf, steps
         if kind_best != EV_NONE:
             # the solution at the located time, exactly as the root finder checked its sign
             tau = best
             _copy_out(out_best, out)
-        # --- accept
-        for b in range(nb):
-            if mode[b] == CONTACT or mode[b] == CLAMPED:
-                hist[0, b] = (F1[b] - F[b]) / tau
-                hist[1, b] = tau
-            else:
-                hist[0, b] = 0.0
-                hist[1, b] = 0.0
-        q[:] = q1
-        qd[:] = qd1
-        z[:] = z1
-        vz[:] = vz1
-        F[:] = F1
-        cur[:, :] = aux
+        _accept(q, qd, z, vz, F, mode, cur, hist, q1, qd1, z1, vz1, F1, aux, tau)
         t = t + tau
-        bt[nbuf] = t
-        bz[nbuf, :] = z
-        bvz[nbuf, :] = vz
-        bF[nbuf, :] = F
-        bd[nbuf, :] = aux[0]
+        _record(bt, bz, bvz, bF, bd, nbuf, t, z, vz, F, cur)
         nbuf += 1
         if kind_best != EV_NONE:
-            b = b_best
-            if kind_best == EV_START:
-                mode[b] = CONTACT
-                deep[b] = aux[0, b] > d[b]
-            elif kind_best == EV_END:
-                mode[b] = FLIGHT
-                F[b] = 0.0
-                deep[b] = False
-            elif kind_best == EV_DEEP or kind_best == EV_SHALLOW:
-                deep[b] = aux[0, b] > d[b]
-            elif kind_best == EV_CLAMP_ON:
-                mode[b] = CLAMPED
-            else:
-                mode[b] = CONTACT
-            if kind_best != EV_DEEP and kind_best != EV_SHALLOW:
-                # dF/dt jumps here (the STEP kink keeps it continuous): restart the BDF2 history
-                hist[0, b] = 0.0
-                hist[1, b] = 0.0
+            _apply_event(kind_best, b_best, F, mode, deep, cur, hist, d)
             evout[0] = kind_best
-            evout[1] = b
+            evout[1] = b_best
             return ST_EVENT, t, nbuf, steps
     return ST_STOP, t, nbuf, steps

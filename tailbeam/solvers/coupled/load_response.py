@@ -90,10 +90,7 @@ def plate_response(
     omega = np.ascontiguousarray(basis.omega, dtype=float)
     zeta = _zeta(zeta, omega.shape[0])
     xyr = _load_points(basis, loads, load_radius)
-    if not (math.isfinite(node_time_ulps) and node_time_ulps >= 0):
-        raise InputError("node_time_ulps", f"must be >= 0, got {node_time_ulps!r}")
-    if not batch_nodes >= 1:
-        raise InputError("batch_nodes", f"must be >= 1, got {batch_nodes!r}")
+    _check_batching(node_time_ulps, batch_nodes)
     _check_memory(len(pts), n_samples, loads, omega.shape[0], batch_nodes, max_bytes)
     nodes = node_jumps(loads, t0, dt, n_samples)
     phi_pts = np.ascontiguousarray(basis.deflection(pts), dtype=float)
@@ -104,12 +101,25 @@ def plate_response(
     r = np.zeros_like(g)
     if quasi_static:
         r = _residual(basis, xyr, pts, seen, g)
+    _add_particular_all(loads, nodes, t0, dt, g, h, r, out)
+    return dict(zip(("w", "v", "a"), out, strict=True))
+
+
+def _check_batching(node_time_ulps, batch_nodes):
+    """InputError naming ``node_time_ulps`` (>= 0) or ``batch_nodes`` (>= 1) if invalid."""
+    if not (math.isfinite(node_time_ulps) and node_time_ulps >= 0):
+        raise InputError("node_time_ulps", f"must be >= 0, got {node_time_ulps!r}")
+    if not batch_nodes >= 1:
+        raise InputError("batch_nodes", f"must be >= 1, got {batch_nodes!r}")
+
+
+def _add_particular_all(loads, nodes, t0, dt, g, h, r, out):
+    """Add every load's particular response inside its sample intervals to out (w, v, a)."""
     target = nodes["target"]
     span = target[nodes["last"]] - target[loads.first]
     buf = np.empty(int(np.max(span, initial=0)) + 4)
     add_particular(t0, dt, loads.t, loads.force, loads.first, nodes["last"], target, g, h, r, buf,
                    *out)  # fmt: skip
-    return dict(zip(("w", "v", "a"), out, strict=True))
 
 
 def uniform_times(times) -> tuple:

@@ -175,10 +175,8 @@ def replay(
             tau = t_nodes[k + 1] - t
             if tau > 0.0:
                 loaded = _seg_forces(phis, seg_phase, k, forces, t_nodes, t, t_nodes[k + 1], f0, f1)
-                if abs(tau - last_tau) > same * tau:
-                    coefficients(omega, zeta, tau, coef)
-                    last_tau = tau
-                _step_inplace(coef, q, qd, f0, f1, loaded)
+                last_tau = _step_reusing(omega, zeta, tau, last_tau, same, coef, q, qd, f0, f1,
+                                         loaded)  # fmt: skip
             t = t_nodes[k + 1]
             k += 1
         tau = tj - t
@@ -188,33 +186,50 @@ def replay(
             loaded = _seg_forces(phis, seg_phase, k, forces, t_nodes, t, t, f0, f1)
             f1[:] = f0
         if tau > 0.0:
-            if abs(tau - last_tau) > same * tau:
-                coefficients(omega, zeta, tau, coef)
-                last_tau = tau
-            _step_inplace(coef, q, qd, f0, f1, loaded)
+            last_tau = _step_reusing(omega, zeta, tau, last_tau, same, coef, q, qd, f0, f1, loaded)
             t = tj
-        if modal:
-            for i in range(n):
-                q_out[i, j] = q[i]
-                qd_out[i, j] = qd[i]
-                qdd_out[i, j] = (f1[i] if loaded else 0.0) - c2[i] * qd[i] - w2[i] * q[i]
-        else:  # only the plate at the points: no (n, len(times)) arrays
-            for p in range(points.shape[0]):
-                w = 0.0
-                v = 0.0
-                a = 0.0
-                for i in range(n):
-                    ph = points[p, i]
-                    w += ph * q[i]
-                    v += ph * qd[i]
-                    acc = -c2[i] * qd[i] - w2[i] * q[i]
-                    if loaded:
-                        acc += f1[i]
-                    a += ph * acc
-                q_out[p, j] = w
-                qd_out[p, j] = v
-                qdd_out[p, j] = a
+        _write_output(j, q, qd, f1, loaded, c2, w2, modal, points, q_out, qd_out, qdd_out)
     return 0
+
+
+@njit(cache=True, inline="always")
+def _step_reusing(omega, zeta, tau, last_tau, same, coef, q, qd, f0, f1, loaded):
+    """Step (q, q') by tau (s) under the linear modal force f0 -> f1, recomputing the
+    coefficients only if tau differs from last_tau by more than ``same`` relative; returns
+    the tau of the coefficients now in coef."""
+    if abs(tau - last_tau) > same * tau:
+        coefficients(omega, zeta, tau, coef)
+        last_tau = tau
+    _step_inplace(coef, q, qd, f0, f1, loaded)
+    return last_tau
+
+
+@njit(cache=True, inline="always")
+def _write_output(j, q, qd, f1, loaded, c2, w2, modal, points, q_out, qd_out, qdd_out):
+    """Column j of the outputs: q, q', q'' if modal, else the deflection (m), velocity (m/s)
+    and acceleration (m/s^2) at the points (mode shapes ``points`` (p, n))."""
+    n = q.shape[0]
+    if modal:
+        for i in range(n):
+            q_out[i, j] = q[i]
+            qd_out[i, j] = qd[i]
+            qdd_out[i, j] = (f1[i] if loaded else 0.0) - c2[i] * qd[i] - w2[i] * q[i]
+        return
+    for p in range(points.shape[0]):  # only the plate at the points: no (n, len(times)) arrays
+        w = 0.0
+        v = 0.0
+        a = 0.0
+        for i in range(n):
+            ph = points[p, i]
+            w += ph * q[i]
+            v += ph * qd[i]
+            acc = -c2[i] * qd[i] - w2[i] * q[i]
+            if loaded:
+                acc += f1[i]
+            a += ph * acc
+        q_out[p, j] = w
+        qd_out[p, j] = v
+        qdd_out[p, j] = a
 
 
 @njit(cache=True)

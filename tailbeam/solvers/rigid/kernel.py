@@ -31,6 +31,14 @@ import math
 import numpy as np
 from numba import njit
 
+from tailbeam.solvers.jit import helper_njit
+from tailbeam.solvers.rigid.dop853 import (  # noqa: F401  (dop853_tables: re-exported)
+    dense_coefficients,
+    dop853_tables,
+    growth,
+    shrink,
+    step,
+)
 from tailbeam.solvers.rigid.regions import (  # noqa: F401  (re-exported for solver.py)
     EPS,
     EV_CLAMP_OFF,
@@ -40,14 +48,11 @@ from tailbeam.solvers.rigid.regions import (  # noqa: F401  (re-exported for sol
     EV_REST,
     EVENT_NAMES,
     INTERIOR,
-    MAX_FACTOR,
-    MIN_FACTOR,
     N_WATCH,
     P_C,
     P_CLAMP,
     P_D,
     P_EREST,
-    SAFETY,
     ST_BUFFER_FULL,
     ST_DURATION,
     ST_REST,
@@ -67,28 +72,196 @@ from tailbeam.solvers.rigid.regions import (  # noqa: F401  (re-exported for sol
     watch_all,
 )
 
-
-def dop853_tables():
-    """(A, B, C, E3, E5, D) of Dormand-Prince 8(5,3) with its 7th-degree dense output."""
-    from scipy.integrate._ivp import dop853_coefficients as co
-
-    return tuple(
-        np.ascontiguousarray(x, dtype=float) for x in (co.A, co.B, co.C, co.E3, co.E5, co.D)
-    )
+# res and ires (the outputs) double as the running maxima and counters of the loop
+R_TAU, R_VOUT, R_PEAK, R_TPEAK, R_PEN = range(5)
+I_STATUS, I_PIECES, I_EVENTS, I_NFEV, I_STEPS, I_ATTEMPTS = range(6)
 
 
-@njit(cache=True)
-def _stages(K, A, first, stop, y0, y1, h, ramp, clamped, par):
-    """Runge-Kutta stages first..stop-1 of the state (delta, u) into K (rows: stages)."""
-    for s in range(first, stop):
-        s0 = 0.0
-        s1 = 0.0
-        for j in range(s):
-            s0 += A[s, j] * K[j, 0]
-            s1 += A[s, j] * K[j, 1]
-        uu = y1 + h * s1
-        K[s, 0] = uu
-        K[s, 1] = accel(y0 + h * s0, uu, ramp, clamped, par)
+@helper_njit
+def _watch_flags(direction, active, ramp, clamped, to_end, par):
+    """Crossing direction (+1 up, -1 down) and whether each watched function is watched in
+    the region (ramp, clamped); to_end: the step ends at the separation already located."""
+    direction[W_FULL] = 1.0 if ramp else -1.0
+    direction[W_CLAMP] = 1.0 if clamped else -1.0
+    direction[W_SEP] = -1.0
+    direction[W_REST] = -1.0
+    direction[W_UMAX] = -1.0
+    direction[W_PEAK] = -1.0
+    active[W_FULL] = True
+    active[W_CLAMP] = par[P_CLAMP] > 0.0 and par[P_C] > 0.0
+    active[W_SEP] = not to_end
+    active[W_REST] = par[P_EREST] > 0.0
+    active[W_UMAX] = True
+    active[W_PEAK] = not clamped
+
+
+@helper_njit
+def _watch_step(y0, y1, n0, n1, coef, ramp, clamped, par, fresh_w, direction, G, buf):
+    """Watched functions at the step's start, its 3 interior points and its end into the rows
+    of G (x = 0, 0.25, 0.5, 0.75, 1); the restart function fresh_w (0 at x = 0) divided by
+    x. Returns the contact force (N) at both ends."""
+    force_a = watch_all(y0, y1, ramp, clamped, par, G[0])
+    force_b = watch_all(n0, n1, ramp, clamped, par, G[4])
+    for q in range(3):
+        dl, uq = dense_eval(INTERIOR[q], y0, y1, coef)
+        watch_all(dl, uq, ramp, clamped, par, buf)
+        for w in range(N_WATCH):
+            G[q + 1, w] = buf[w]
+    if fresh_w >= 0:
+        G[0, fresh_w] = -direction[fresh_w]
+        for q in range(3):
+            G[q + 1, fresh_w] /= INTERIOR[q]
+    return force_a, force_b
+
+
+@helper_njit
+def _root_in(w, q, dirn, fresh, G, y0, y1, coef, ramp, clamped, par, buf, xtol):
+    """Root (fraction of the step) of watched function w in the q-th quarter of the step
+    (values at its ends: G[q, w], G[q + 1, w]) if it crosses there in direction dirn (+1 up,
+    -1 down), else -1; fresh: w is the restart function (``regions.find_root``)."""
+    xa = 0.0 if q == 0 else INTERIOR[q - 1]
+    xb = INTERIOR[q] if q < 3 else 1.0
+    va, vb = G[q, w], G[q + 1, w]
+    if not crosses(va, vb, dirn):
+        return -1.0
+    return find_root(w, xa, va, xb, vb, fresh, y0, y1, coef, ramp, clamped, par, buf, xtol)
+
+
+@helper_njit
+def _first_kink(active, direction, G, fresh_w, y0, y1, coef, ramp, clamped, par, buf, xtol):
+    """Earliest crossing (x_sw, w_sw) in the step of a terminal watched function (kinks,
+    separation, rest): x_sw in [0, 1] of the step, w_sw = -1 (x_sw = 2) if none."""
+    x_sw = 2.0
+    w_sw = -1
+    for w in range(4):
+        if not active[w]:
+            continue
+        for q in range(4):
+            if (0.0 if q == 0 else INTERIOR[q - 1]) >= x_sw:
+                break
+            xr = _root_in(w, q, direction[w], fresh_w == w, G, y0, y1, coef, ramp, clamped, par,
+                          buf, xtol)  # fmt: skip
+            if xr >= 0.0:
+                if xr < x_sw:
+                    x_sw, w_sw = xr, w
+                break
+    return x_sw, w_sw
+
+
+@helper_njit
+def _maxima(active, G, x_end, tau, h, y0, y1, coef, ramp, clamped, par, buf, xtol, force_a,
+            res):  # fmt: skip
+    """Update the maxima of the penetration (m) and of the force (N, at tau_peak s) in res
+    with the step up to x_end of it (its start included, its end not)."""
+    pen, peak, tau_peak = res[R_PEN], res[R_PEAK], res[R_TPEAK]
+    for w in (W_UMAX, W_PEAK):
+        if not active[w]:
+            continue
+        for q in range(4):
+            if (0.0 if q == 0 else INTERIOR[q - 1]) >= x_end:
+                break
+            xr = _root_in(w, q, -1.0, False, G, y0, y1, coef, ramp, clamped, par, buf, xtol)
+            if 0.0 <= xr <= x_end:
+                dl, uq = dense_eval(xr, y0, y1, coef)
+                fr = watch_all(dl, uq, ramp, clamped, par, buf)
+                if w == W_UMAX:
+                    pen = max(pen, dl)
+                elif fr > peak:
+                    peak, tau_peak = fr, tau + xr * h
+    _update_maxima(res, force_a, tau, y0, pen, peak, tau_peak)
+
+
+@helper_njit
+def _update_maxima(res, force, tau_f, delta, pen, peak, tau_peak):
+    """Write the maxima (pen m, peak N at tau_peak s) into res after comparing them with a
+    force (N) at tau_f (s) and a penetration delta (m)."""
+    if force > peak:
+        peak, tau_peak = force, tau_f
+    res[R_PEN] = max(pen, delta)
+    res[R_PEAK] = peak
+    res[R_TPEAK] = tau_peak
+
+
+@helper_njit
+def _examine(K, A, D, y0, y1, n0, n1, f0, f1, tau, h, h0, ramp, clamped, par, fresh_w, to_end,
+             W, res, ires):  # fmt: skip
+    """Dense output (into W[0]; counted in ires) and events of a step of h (s) from tau (s)
+    that passed the error test (W: scratch arrays, see ``integrate_contact``): returns
+    (x_sw, w_sw, redo, force_b) with the earliest terminal crossing (``_first_kink``), redo
+    True if it is a separation to end the step at (beyond delta = 0 the force is 0: the step
+    straddles a kink, so rather than trust its dense output it is redone to end exactly
+    there, unless that is closer than the time resolution: then it ends at the root), and
+    the force (N) at the step's end; else the maxima in res are updated with the step."""
+    coef, buf, direction, active, G = W
+    ires[I_STEPS] += 1
+    ires[I_NFEV] += 3
+    dense_coefficients(K, A, D, y0, y1, n0, n1, f0, f1, h, ramp, clamped, par, coef)
+    _watch_flags(direction, active, ramp, clamped, to_end, par)
+    force_a, force_b = _watch_step(y0, y1, n0, n1, coef, ramp, clamped, par, fresh_w,
+                                   direction, G, buf)  # fmt: skip
+    xtol = 2.0 * EPS * (abs(tau) + h) / h
+    x_sw, w_sw = _first_kink(active, direction, G, fresh_w, y0, y1, coef, ramp, clamped, par,
+                             buf, xtol)  # fmt: skip
+    if w_sw == W_SEP and x_sw * h > 64.0 * EPS * max(abs(tau), h0):
+        return x_sw, w_sw, True, force_b
+    _maxima(active, G, min(x_sw, 1.0), tau, h, y0, y1, coef, ramp, clamped, par, buf, xtol,
+            force_a, res)  # fmt: skip
+    return x_sw, w_sw, False, force_b
+
+
+@helper_njit
+def _store_piece(p_tau, p_h, p_y, p_coef, ires, tau, h, y0, y1, coef):
+    """Append a dense-output piece: start tau (s), length h (s), start state, coefficients;
+    returns False (nothing written) if a buffer is full."""
+    npc = ires[I_PIECES]
+    if npc >= p_tau.shape[0]:
+        return False
+    p_tau[npc] = tau
+    p_h[npc] = h
+    p_y[npc, 0] = y0
+    p_y[npc, 1] = y1
+    for i in range(7):
+        p_coef[npc, i, 0] = coef[i, 0]
+        p_coef[npc, i, 1] = coef[i, 1]
+    ires[I_PIECES] = npc + 1
+    return True
+
+
+@helper_njit
+def _at_kink(x_sw, tau, h, y0, y1, coef, ramp, clamped, par, buf, res):
+    """State at the located crossing x_sw of the step: (tau_ev s, delta m, u m/s); the
+    maxima in res updated with it."""
+    tau_ev = tau + x_sw * h
+    d_ev, u_ev = dense_eval(x_sw, y0, y1, coef)
+    f_ev = watch_all(d_ev, u_ev, ramp, clamped, par, buf)
+    _update_maxima(res, f_ev, tau_ev, d_ev, res[R_PEN], res[R_PEAK], res[R_TPEAK])
+    return tau_ev, d_ev, u_ev
+
+
+@helper_njit
+def _switch_region(w_sw, d_ev, ramp, clamped, par):
+    """The region after kink w_sw (full damping or clamp): (delta m to restart from, ramp,
+    clamped, event code); the full-damping restart sits exactly on delta = d."""
+    if w_sw == W_FULL:
+        return par[P_D], not ramp, clamped, EV_FULL
+    clamped = not clamped
+    return d_ev, ramp, clamped, EV_CLAMP_ON if clamped else EV_CLAMP_OFF
+
+
+@helper_njit
+def _log(ev_tau, ev_kind, ires, tau, kind):
+    """Append event (tau s, kind) to the event buffer (its room checked per step)."""
+    ev_tau[ires[I_EVENTS]] = tau
+    ev_kind[ires[I_EVENTS]] = kind
+    ires[I_EVENTS] += 1
+
+
+@helper_njit
+def _finish(res, ires, status, tau, v_out):
+    """End status and time (s), rebound speed (m/s; NaN unless separated, 0 at rest)."""
+    ires[I_STATUS] = status
+    res[R_TAU] = tau
+    res[R_VOUT] = v_out
 
 
 @njit(cache=True)
@@ -101,245 +274,62 @@ def integrate_contact(
     tau_max. Writes the dense-output pieces (p_*), the kink events (ev_*), and
     res = [tau_end, v_out, peak_force, tau_peak, max_penetration],
     ires = [status, n_pieces, n_events, nfev, n_steps, n_attempts]."""
-    K = np.zeros((16, 2))
-    coef = np.zeros((7, 2))
-    ga = np.zeros(N_WATCH)
-    gb = np.zeros(N_WATCH)
-    gi = np.zeros((3, N_WATCH))
-    buf = np.zeros(N_WATCH)
-    direction = np.zeros(N_WATCH)
-    active = np.zeros(N_WATCH, dtype=np.bool_)
-    clamp_law = par[P_CLAMP] > 0.0 and par[P_C] > 0.0
-    tau, y0, y1 = 0.0, 0.0, v_in
-    ramp, clamped = True, False
-    fresh_w = -1
-    npc = nev = nfev = nsteps = attempts = 0
-    peak = tau_peak = pen = 0.0
-    v_out = math.nan
+    K = np.zeros((16, 2))  # stages; W = (coef, buf, direction, active, watched values G)
+    W = (np.zeros((7, 2)), np.zeros(N_WATCH), np.zeros(N_WATCH), np.zeros(N_WATCH, dtype=np.bool_),
+         np.zeros((5, N_WATCH)))  # fmt: skip
+    tau, y0, y1, ramp, clamped, fresh_w = 0.0, 0.0, v_in, True, False, -1
+    res[:] = 0.0
+    ires[:] = 0
     f0, f1 = y1, accel(y0, y1, ramp, clamped, par)
-    nfev += 1
+    ires[I_NFEV] = 1
     h = min(h0, h_max)
-    rejected = False
-    to_end = False  # this step was cut to end exactly at the separation
-    status = ST_DURATION
+    rejected = to_end = False  # to_end: this step was cut to end exactly at the separation
     while True:
-        if tau >= tau_max:
-            status = ST_DURATION
-            break
-        if attempts >= max_steps:
-            status = ST_STEP_LIMIT
-            break
-        last = False
-        if h >= tau_max - tau:
-            h = tau_max - tau
-            last = True
+        if tau >= tau_max or ires[I_ATTEMPTS] >= max_steps:
+            return _finish(res, ires, ST_DURATION if tau >= tau_max else ST_STEP_LIMIT, tau,
+                           math.nan)  # fmt: skip
+        last = h >= tau_max - tau
+        h = tau_max - tau if last else h
         if h <= 8.0 * EPS * max(abs(tau), h0):
-            status = ST_STEP_TINY
-            break
-        attempts += 1
-        # --- one DOP853 step (autonomous system) ---
-        K[0, 0] = f0
-        K[0, 1] = f1
-        _stages(K, A, 1, 12, y0, y1, h, ramp, clamped, par)
-        b0 = 0.0
-        b1 = 0.0
-        for j in range(12):
-            b0 += B[j] * K[j, 0]
-            b1 += B[j] * K[j, 1]
-        n0 = y0 + h * b0
-        n1 = y1 + h * b1
-        K[12, 0] = n1
-        K[12, 1] = accel(n0, n1, ramp, clamped, par)
-        nfev += 12
-        e50 = e51 = e30 = e31 = 0.0
-        for j in range(13):
-            e50 += E5[j] * K[j, 0]
-            e51 += E5[j] * K[j, 1]
-            e30 += E3[j] * K[j, 0]
-            e31 += E3[j] * K[j, 1]
-        sc0 = atol0 + rtol * max(abs(y0), abs(n0))
-        sc1 = atol1 + rtol * max(abs(y1), abs(n1))
-        err5 = (e50 / sc0) ** 2 + (e51 / sc1) ** 2
-        err3 = (e30 / sc0) ** 2 + (e31 / sc1) ** 2
-        err = 0.0
-        if not (err5 == 0.0 and err3 == 0.0):  # NaN goes this way too
-            err = h * err5 / math.sqrt((err5 + 0.01 * err3) * 2.0)
+            return _finish(res, ires, ST_STEP_TINY, tau, math.nan)
+        ires[I_ATTEMPTS] += 1
+        ires[I_NFEV] += 12
+        n0, n1, err = step(K, A, B, E3, E5, y0, y1, f0, f1, h, ramp, clamped, par, rtol, atol0,
+                           atol1)  # fmt: skip
         if not err <= 1.0:  # also rejects a NaN error (overflow in a far-off stage)
-            h *= max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0)) if err > 1.0 else MIN_FACTOR
-            rejected = True
-            to_end = False  # a shorter step cannot end at the separation: locate it again
+            h *= shrink(err)
+            # (a shorter step cannot end at the separation: locate it again)
+            rejected, to_end = True, False
             continue
-        nsteps += 1
-        # --- dense output (3 extra stages) ---
-        _stages(K, A, 13, 16, y0, y1, h, ramp, clamped, par)
-        nfev += 3
-        for q in range(2):
-            yq_old = y0 if q == 0 else y1
-            yq_new = n0 if q == 0 else n1
-            dy = yq_new - yq_old
-            fo = f0 if q == 0 else f1
-            coef[0, q] = dy
-            coef[1, q] = h * fo - dy
-            coef[2, q] = 2.0 * dy - h * (K[12, q] + fo)
-            for i in range(4):
-                acc = 0.0
-                for j in range(16):
-                    acc += D[i, j] * K[j, q]
-                coef[3 + i, q] = h * acc
-        # --- watched functions at both ends and 3 interior points ---
-        direction[W_FULL] = 1.0 if ramp else -1.0
-        direction[W_CLAMP] = 1.0 if clamped else -1.0
-        direction[W_SEP] = -1.0
-        direction[W_REST] = -1.0
-        direction[W_UMAX] = -1.0
-        direction[W_PEAK] = -1.0
-        active[W_FULL] = True
-        active[W_CLAMP] = clamp_law
-        active[W_SEP] = not to_end
-        active[W_REST] = par[P_EREST] > 0.0
-        active[W_UMAX] = True
-        active[W_PEAK] = not clamped
-        force_a = watch_all(y0, y1, ramp, clamped, par, ga)
-        force_b = watch_all(n0, n1, ramp, clamped, par, gb)
-        for q in range(3):
-            dl, uq = dense_eval(INTERIOR[q], y0, y1, coef)
-            watch_all(dl, uq, ramp, clamped, par, buf)
-            for w in range(N_WATCH):
-                gi[q, w] = buf[w]
-        if fresh_w >= 0:
-            ga[fresh_w] = -direction[fresh_w]
-            for q in range(3):
-                gi[q, fresh_w] /= INTERIOR[q]
-        xtol = 2.0 * EPS * (abs(tau) + h) / h
-        # earliest kink (terminal) crossing in the step
-        x_sw = 2.0
-        w_sw = -1
-        for w in range(4):
-            if not active[w]:
-                continue
-            xa, va = 0.0, ga[w]
-            for q in range(4):
-                xb = INTERIOR[q] if q < 3 else 1.0
-                vb = gi[q, w] if q < 3 else gb[w]
-                if xa >= x_sw:
-                    break
-                if crosses(va, vb, direction[w]):
-                    xr = find_root(w, xa, va, xb, vb, fresh_w == w, y0, y1, coef, ramp, clamped,
-                               par, buf, xtol)  # fmt: skip
-                    if xr < x_sw:
-                        x_sw, w_sw = xr, w
-                    break
-                xa, va = xb, vb
-        if w_sw == W_SEP and x_sw * h > 64.0 * EPS * max(abs(tau), h0):
-            # Beyond delta = 0 the force is 0: the step straddles a kink, so rather than trust
-            # its dense output, redo it to end exactly at the located separation (unless that
-            # is closer than the time resolution: then it ends at the root below).
-            h *= x_sw
-            to_end = True
+        x_sw, w_sw, redo, force_b = _examine(K, A, D, y0, y1, n0, n1, f0, f1, tau, h, h0,
+                                             ramp, clamped, par, fresh_w, to_end, W, res,
+                                             ires)  # fmt: skip
+        if redo:
+            h, to_end = h * x_sw, True
             continue
-        x_end = min(x_sw, 1.0)
-        # maxima of penetration and force before it (no restart)
-        for w in (W_UMAX, W_PEAK):
-            if not active[w]:
-                continue
-            xa, va = 0.0, ga[w]
-            for q in range(4):
-                xb = INTERIOR[q] if q < 3 else 1.0
-                vb = gi[q, w] if q < 3 else gb[w]
-                if xa >= x_end:
-                    break
-                if crosses(va, vb, -1.0):
-                    xr = find_root(w, xa, va, xb, vb, False, y0, y1, coef, ramp, clamped, par,
-                               buf, xtol)  # fmt: skip
-                    if xr <= x_end:
-                        dl, uq = dense_eval(xr, y0, y1, coef)
-                        fr = watch_all(dl, uq, ramp, clamped, par, buf)
-                        if w == W_UMAX:
-                            pen = max(pen, dl)
-                        elif fr > peak:
-                            peak, tau_peak = fr, tau + xr * h
-                xa, va = xb, vb
-        if force_a > peak:
-            peak, tau_peak = force_a, tau
-        pen = max(pen, y0)
-        # store the piece
-        if npc >= p_tau.shape[0] or nev >= ev_tau.shape[0]:
-            status = ST_BUFFER_FULL
-            break
-        p_tau[npc] = tau
-        p_h[npc] = h
-        p_y[npc, 0] = y0
-        p_y[npc, 1] = y1
-        for i in range(7):
-            p_coef[npc, i, 0] = coef[i, 0]
-            p_coef[npc, i, 1] = coef[i, 1]
-        npc += 1
-        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** (-1.0 / 8.0))
-        if rejected:
-            factor = min(1.0, factor)
+        if ires[I_EVENTS] >= ev_tau.shape[0] or not _store_piece(p_tau, p_h, p_y, p_coef, ires,
+                                                                 tau, h, y0, y1, W[0]):  # fmt: skip
+            return _finish(res, ires, ST_BUFFER_FULL, tau, math.nan)
+        h_next = min(h * growth(err, rejected), h_max)
         rejected = False
-        h_next = min(h * factor, h_max)
         if w_sw < 0:
-            if force_b > peak:
-                peak, tau_peak = force_b, tau + h
-            pen = max(pen, n0)
+            _update_maxima(res, force_b, tau + h, n0, res[R_PEN], res[R_PEAK], res[R_TPEAK])
             if to_end:
-                tau += h
-                ev_tau[nev] = tau
-                ev_kind[nev] = EV_END
-                nev += 1
-                v_out = -n1
-                status = ST_SEPARATED
-                break
+                _log(ev_tau, ev_kind, ires, tau + h, EV_END)
+                return _finish(res, ires, ST_SEPARATED, tau + h, -n1)
             tau = tau_max if last else tau + h
-            y0, y1 = n0, n1
-            f0, f1 = K[12, 0], K[12, 1]
-            fresh_w = -1
-            h = h_next
+            y0, y1, f0, f1, fresh_w, h = n0, n1, K[12, 0], K[12, 1], -1, h_next
             continue
         # --- a kink: restart there in the new region ---
-        tau_ev = tau + x_sw * h
-        d_ev, u_ev = dense_eval(x_sw, y0, y1, coef)
-        f_ev = watch_all(d_ev, u_ev, ramp, clamped, par, buf)
-        if f_ev > peak:
-            peak, tau_peak = f_ev, tau_ev
-        pen = max(pen, d_ev)
-        tau = tau_ev
+        tau, d_ev, u_ev = _at_kink(x_sw, tau, h, y0, y1, W[0], ramp, clamped, par, W[1], res)
         if w_sw == W_SEP or (d_ev <= 0.0 and u_ev < 0.0):
             # (a kink this close to the separation that the restart state is already out)
-            ev_tau[nev] = tau_ev
-            ev_kind[nev] = EV_END
-            nev += 1
-            v_out = -u_ev
-            status = ST_SEPARATED
-            break
+            _log(ev_tau, ev_kind, ires, tau, EV_END)
+            return _finish(res, ires, ST_SEPARATED, tau, -u_ev)
         if w_sw == W_REST:
-            status = ST_REST
-            v_out = 0.0
-            break
-        if w_sw == W_FULL:
-            d_ev = par[P_D]
-            ramp = not ramp
-            ev_kind[nev] = EV_FULL
-        else:
-            clamped = not clamped
-            ev_kind[nev] = EV_CLAMP_ON if clamped else EV_CLAMP_OFF
-        ev_tau[nev] = tau_ev
-        nev += 1
-        y0, y1 = d_ev, u_ev
+            return _finish(res, ires, ST_REST, tau, 0.0)
+        y0, ramp, clamped, kind = _switch_region(w_sw, d_ev, ramp, clamped, par)
+        _log(ev_tau, ev_kind, ires, tau, kind)
+        y1, fresh_w, to_end, h = u_ev, w_sw, False, h_next
         f0, f1 = y1, accel(y0, y1, ramp, clamped, par)
-        nfev += 1
-        fresh_w = w_sw
-        to_end = False
-        h = h_next
-    res[0] = tau
-    res[1] = v_out
-    res[2] = peak
-    res[3] = tau_peak
-    res[4] = pen
-    ires[0] = status
-    ires[1] = npc
-    ires[2] = nev
-    ires[3] = nfev
-    ires[4] = nsteps
-    ires[5] = attempts
+        ires[I_NFEV] += 1

@@ -104,86 +104,33 @@ class _Contact:
         return impact.region_force_rate(delta, u, accel, *self._law(), ramp)
 
     def run(self, v_in, tau_max, steps_left):
+        """Integrate the contact from delta = 0, u = v_in (m/s) for at most tau_max (s) and
+        steps_left steps: a ``driver.ContactOutcome``."""
         p = self.p
-        delta_s, v_s, t_s = p.scales(v_in)
-        atol = np.array([self.rtol * delta_s, self.rtol * v_s])
+        t_s = p.scales(v_in)[2]
         tau, y = 0.0, np.array([0.0, v_in])
         ramp, clamped = p.d > 0.0, False
         events, pieces = [], []
-        peak, tau_peak, pen = 0.0, 0.0, 0.0
-        nfev = n_steps = 0
+        maxima = (0.0, 0.0, 0.0)  # (peak force N, its tau s, max penetration m)
+        work = [0, 0]  # nfev, steps
         fresh = None  # the switch event whose root we restart on
         status, v_out = "duration", math.nan
         while tau < tau_max:
             evs = self._events(ramp, clamped, fresh, tau)
-            t_stop = min(tau_max, tau + CHUNK * t_s)
             rhs = self._rhs(ramp, clamped)
-            sol = solve_ivp(
-                rhs,
-                (tau, t_stop),
-                y,
-                method="DOP853",
-                rtol=self.rtol,
-                atol=atol,
-                events=[ev for ev, _, _ in evs],
-                dense_output=True,
-                max_step=t_s,
-                first_step=min(
-                    t_s * self.rtol ** (1.0 / (p.e + 2.0)), 0.5 * p.d / v_s, t_stop - tau
-                ),
-            )
-            if sol.status < 0:
-                raise RuntimeError(f"reference integrator failed: {sol.message}")
-            nfev += sol.nfev
-            n_steps += len(sol.t) - 1
-            if n_steps > steps_left:
-                raise WorkLimitError(
-                    f"ball {p.name!r}: reference solver exceeded max_steps; raise max_steps"
-                )
-            ts = sol.sol.ts
-            for j, interp in enumerate(sol.sol.interpolants):
-                pieces.append((ts[j], interp.t_old, interp.h, interp.y_old.copy(), interp.F))
-            # candidates at both ends of this region for the peaks
-            for s_tau, s_y in ((sol.t[0], sol.y[:, 0]), (sol.t[-1], sol.y[:, -1])):
-                f = self.force(s_y[0], s_y[1], ramp, clamped)
-                if f > peak:
-                    peak, tau_peak = f, s_tau
-                pen = max(pen, s_y[0])
-            hit = None
-            for (_, kind, role), te, ye in zip(evs, sol.t_events, sol.y_events, strict=True):
-                for t_e, y_e in zip(te, ye, strict=True):
-                    if role == "peak":
-                        f = self.force(y_e[0], y_e[1], ramp, clamped)
-                        if f > peak:
-                            peak, tau_peak = f, t_e
-                    elif role == "pen":
-                        pen = max(pen, y_e[0])
-                    elif sol.status == 1 and t_e == sol.t[-1]:
-                        hit = kind
+            sol = self._solve_region(rhs, tau, min(tau_max, tau + CHUNK * t_s), y, evs, v_in)
+            self._count(work, sol, steps_left)
+            pieces.extend(_pieces(sol))
+            maxima, hit = self._maxima(sol, evs, ramp, clamped, maxima)
             tau, y = sol.t[-1], sol.y[:, -1].copy()
             fresh = hit
             if hit is None:
                 continue
-            if hit == EventKind.FULL_DAMPING:
-                y[0] = p.d  # exactly on the kink
-                ramp = not ramp
-                events.append((tau, hit))
-            elif hit in (EventKind.CLAMP_ON, EventKind.CLAMP_OFF):
-                clamped = hit == EventKind.CLAMP_ON
+            if hit in (EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF):
+                ramp, clamped = self._switch(hit, y, ramp, clamped)
                 events.append((tau, hit))
             elif hit == EventKind.CONTACT_END:
-                # Past delta = 0 the force is 0, so the step holding the root straddles a kink:
-                # integrate its part up to the root again, on its own, for the exit state.
-                if len(sol.t) >= 2 and sol.t[-2] < tau:
-                    redo = solve_ivp(rhs, (sol.t[-2], tau), sol.y[:, -2], method="DOP853",
-                                     rtol=self.rtol, atol=atol, dense_output=True,
-                                     first_step=tau - sol.t[-2])  # fmt: skip
-                    nfev += redo.nfev
-                    y = redo.y[:, -1]
-                    pieces.pop()
-                    for j, interp in enumerate(redo.sol.interpolants):
-                        piece = (redo.sol.ts[j], interp.t_old, interp.h, interp.y_old.copy())
-                        pieces.append((*piece, interp.F))
+                y = self._exit_state(rhs, sol, tau, y, v_in, pieces, work)
                 events.append((tau, hit))
                 status, v_out = "separated", -y[1]
                 break
@@ -191,11 +138,91 @@ class _Contact:
                 status, v_out = "rest", 0.0
                 break
         tau_start, tau_old, step, y_old, coef = (np.array(x) for x in zip(*pieces, strict=True))
+        peak, tau_peak, pen = maxima
         return driver.ContactOutcome(
             status, float(tau), float(v_out), float(peak), float(tau_peak), float(pen),
             [(float(t), k) for t, k in events],
-            tau_start, tau_old, step, y_old, coef, nfev, n_steps,
+            tau_start, tau_old, step, y_old, coef, work[0], work[1],
         )  # fmt: skip
+
+    def _atol(self, v_in):
+        """Absolute tolerances (m, m/s) of the state from the contact's scales."""
+        delta_s, v_s, _t_s = self.p.scales(v_in)
+        return np.array([self.rtol * delta_s, self.rtol * v_s])
+
+    def _solve_region(self, rhs, tau, t_stop, y, evs, v_in):
+        """solve_ivp in one region from (tau s, y) to t_stop (s) or the first terminal event."""
+        p = self.p
+        _delta_s, v_s, t_s = p.scales(v_in)
+        sol = solve_ivp(
+            rhs,
+            (tau, t_stop),
+            y,
+            method="DOP853",
+            rtol=self.rtol,
+            atol=self._atol(v_in),
+            events=[ev for ev, _, _ in evs],
+            dense_output=True,
+            max_step=t_s,
+            first_step=min(t_s * self.rtol ** (1.0 / (p.e + 2.0)), 0.5 * p.d / v_s, t_stop - tau),
+        )
+        if sol.status < 0:
+            raise RuntimeError(f"reference integrator failed: {sol.message}")
+        return sol
+
+    def _count(self, work, sol, steps_left):
+        """Add the solve's work to work = [nfev, steps]; WorkLimitError past steps_left."""
+        work[0] += sol.nfev
+        work[1] += len(sol.t) - 1
+        if work[1] > steps_left:
+            raise WorkLimitError(
+                f"ball {self.p.name!r}: reference solver exceeded max_steps; raise max_steps"
+            )
+
+    def _maxima(self, sol, evs, ramp, clamped, maxima):
+        """The maxima (peak N, tau_peak s, pen m) updated with the region's ends and its peak
+        events, and the terminal event the solve stopped on (None if it reached t_stop)."""
+        peak, tau_peak, pen = maxima
+        # candidates at both ends of this region for the peaks
+        for s_tau, s_y in ((sol.t[0], sol.y[:, 0]), (sol.t[-1], sol.y[:, -1])):
+            f = self.force(s_y[0], s_y[1], ramp, clamped)
+            if f > peak:
+                peak, tau_peak = f, s_tau
+            pen = max(pen, s_y[0])
+        hit = None
+        for (_, kind, role), te, ye in zip(evs, sol.t_events, sol.y_events, strict=True):
+            for t_e, y_e in zip(te, ye, strict=True):
+                if role == "peak":
+                    f = self.force(y_e[0], y_e[1], ramp, clamped)
+                    if f > peak:
+                        peak, tau_peak = f, t_e
+                elif role == "pen":
+                    pen = max(pen, y_e[0])
+                elif sol.status == 1 and t_e == sol.t[-1]:
+                    hit = kind
+        return (peak, tau_peak, pen), hit
+
+    def _switch(self, hit, y, ramp, clamped):
+        """The region (ramp, clamped) after a kink; a full-damping restart sits exactly on
+        delta = d (y changed in place)."""
+        if hit == EventKind.FULL_DAMPING:
+            y[0] = self.p.d  # exactly on the kink
+            return not ramp, clamped
+        return ramp, hit == EventKind.CLAMP_ON
+
+    def _exit_state(self, rhs, sol, tau, y, v_in, pieces, work):
+        """State at the separation tau (s). Past delta = 0 the force is 0, so the step holding
+        the root straddles a kink: its part up to the root is integrated again, on its own,
+        and replaces the step's piece."""
+        if not (len(sol.t) >= 2 and sol.t[-2] < tau):
+            return y
+        redo = solve_ivp(rhs, (sol.t[-2], tau), sol.y[:, -2], method="DOP853", rtol=self.rtol,
+                         atol=self._atol(v_in), dense_output=True,
+                         first_step=tau - sol.t[-2])  # fmt: skip
+        work[0] += redo.nfev
+        pieces.pop()
+        pieces.extend(_pieces(redo))
+        return redo.y[:, -1]
 
     def _rhs(self, ramp, clamped):
         p = self.p
@@ -255,3 +282,11 @@ class _Contact:
                 )
             )
         return evs
+
+
+def _pieces(sol):
+    """The dense-output pieces of a solve_ivp solution: (tau_start, t_old, h, y_old, F)."""
+    ts = sol.sol.ts
+    return [
+        (ts[j], it.t_old, it.h, it.y_old.copy(), it.F) for j, it in enumerate(sol.sol.interpolants)
+    ]

@@ -52,7 +52,7 @@ from tailbeam.physics.impact import (
 from tailbeam.physics.impact import power as _pow  # noqa: F401  (the names callers use)
 from tailbeam.physics.impact import region_damping as damping_in_region  # noqa: F401
 from tailbeam.physics.impact import region_damping_slope as damping_slope
-from tailbeam.solvers.stream.jit import helper_njit
+from tailbeam.solvers.jit import helper_njit
 
 L_K, L_E, L_C, L_D, L_CLAMP, L_CRES = range(6)
 RESIDUAL_RTOL = 1e-14  # relative convergence of the residual-flexibility force solve

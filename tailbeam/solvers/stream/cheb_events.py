@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from tailbeam.solvers.stream.jit import helper_njit
+from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.stream.step_events import _VINV, NODES, STEP_POINTS
 
 VINV = np.ascontiguousarray(_VINV)

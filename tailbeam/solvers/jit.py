@@ -1,16 +1,25 @@
-"""The decorator of the compiled active-set helpers: ``njit(cache=True, _nrt=False)``.
+"""The decorator of the compiled kernels' helpers: ``njit(cache=True, _nrt=False)``.
 
 Numba's runtime (NRT) reference-counts arrays atomically: every array handed to a compiled
 function that is not inlined, and every array unpacked from a tuple, costs an atomic
 increment and decrement (~50 cycles). The active-set kernel calls small helpers (the
 right-hand side, the event rows) hundreds of times per step with 10-25 arrays each, so the
-counting dominated: 11 us per step for one ball, against 0.9 us for the rigid kernel.
+counting dominated: 11 us per step for one ball, against 0.9 us for the rigid kernel (with
+the helpers below: 2.5 us for one ball, 9 us for eight, from 50; results bit-identical). The
+rigid kernel's parts (``rigid.kernel``, ``rigid.dop853``) are helpers too: as plain ``njit``
+functions they made the kernel 40 % slower (measured with ``benchmarks/time_revisions.py``).
 
 ``_nrt=False`` compiles a function without the runtime: no reference counting. It is safe for
 functions that never allocate, return or store an array (they only read and write the
-arrays they are given, which the caller keeps alive): every helper decorated here. The one
-function that allocates (``active_kernel.advance``) keeps plain ``njit``. Measured: a step of
-one ball 2.5 us (from 11), of eight balls 9 us (from 50), results bit-identical.
+arrays they are given, which the caller keeps alive; no slice assignment ``a[:] = b``
+either, which needs the runtime): every helper decorated here. The functions that allocate
+(``active_kernel.advance`` and ``_workspaces``, ``rigid.kernel.integrate_contact``, the
+coupled kernel's ``run`` and ``solve_step`` and what they call with tuples) keep plain ``njit``;
+a helper compiled here cannot call one that allocates (numba compiles the callee with the
+caller's flags). The parts of ``solve_step`` that allocate are inlined into it
+(``njit(inline="always")``, numba's own inlining: no call). Handing tuples of arrays to
+a plain ``njit`` helper in a per-step loop cost the coupled kernel 10 % (their members are
+counted one by one), so its loop calls such helpers only when there is an event to locate.
 
 ``_nrt`` is a numba target option since 0.19 (listed in ``numba.core.cpu``'s options, not in
 the user documentation: see numba issues 1204, 2350). If a numba release dropped it,
