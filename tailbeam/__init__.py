@@ -18,6 +18,7 @@ from tailbeam.physics.contact_law import (  # noqa: E402
     impact_force,
     step,
 )
+from tailbeam.physics.contacts import PLATE, ContactTable  # noqa: E402
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE, Material, get_material  # noqa: E402
 from tailbeam.result import Result  # noqa: E402
 from tailbeam.simulation import simulate  # noqa: E402
@@ -26,6 +27,8 @@ __all__ = [
     "Ball",
     "Plate",
     "ImpactLaw",
+    "ContactTable",
+    "PLATE",
     "ball_ball_law",
     "ball_plate_law",
     "impact_force",

@@ -25,6 +25,7 @@ Rules (and why):
 import math
 
 from tailbeam.errors import InputError, WorkLimitError
+from tailbeam.physics.contacts import PLATE
 from tailbeam.physics.hertz import hertz_max_penetration
 
 MAX_PENETRATION_FRACTION = 0.1  # of the ball radius
@@ -122,9 +123,10 @@ def check_streams(scene, engine=None) -> None:
     _check_particle_count(scene, engine, len(scene.particles) - len(scene.balls), "has")
     streams = {s.name: i for i, s in enumerate(scene.streams, start=1)}
     g_n = scene.gravity * math.cos(math.radians(scene.inclination))
-    for p in scene.particles[len(scene.balls) :]:
+    contacts, first = scene.contacts(), len(scene.balls)
+    for k, p in enumerate(scene.particles[first:], start=first):
         ball = p.ball()
-        law = scene.contact.law_for(ball, scene.plate.material)
+        law = contacts.law(k, PLATE)
         key = "velocity" if ball.velocity[2] ** 2 > 2.0 * g_n * ball.gap else "height"
         check_ball_contact(ball, law, g_n, f"streams[{streams[p.stream]}].{key}")
 

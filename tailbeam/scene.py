@@ -15,6 +15,7 @@ from tailbeam.errors import (
 )
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, Plate
 from tailbeam.physics.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
+from tailbeam.physics.contacts import ContactTable
 from tailbeam.physics.materials import Material
 from tailbeam.signals.noise import NoiseSpec
 
@@ -300,8 +301,22 @@ class Scene:
         return [s.rate * (min(s.stop, self.duration) - s.start) for s in self.streams]
 
     def laws(self) -> tuple[ImpactLaw, ...]:
-        """The ball-plate law of each ball, in ball order."""
-        return tuple(self.contact.law_for(b, self.plate.material) for b in self.balls)
+        """The ball-plate law of each ball, in ball order: the plate rows of the balls'
+        contact table (``contacts``; this view does not generate stream particles)."""
+        if not self.streams:
+            return self.contacts().plate_laws()
+        balls = ContactTable.from_settings(self.balls, self.plate.material, self.contact)
+        return balls.plate_laws()
+
+    def contacts(self) -> ContactTable:
+        """The contact table of every body (tailbeam.physics.contacts): the balls, then the
+        streams' particles (``particles``, generated on first use), each with its plate row;
+        ball-ball rows (eq. 5) are created when a solver asks for a pair. Built once."""
+        return self._contacts
+
+    @functools.cached_property
+    def _contacts(self) -> ContactTable:
+        return ContactTable.from_settings(self.particles, self.plate.material, self.contact)
 
     def first_ball_contact(self):
         """(j, i, t): the first pair of balls (0-based, i < j) whose horizontal paths (uniform

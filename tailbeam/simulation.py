@@ -117,7 +117,7 @@ def _rigid(scene, how):
 
     with task(f"simulating {scene.duration:g} s, {len(scene.balls)} balls, rigid plate"):
         return simulate_rigid(
-            scene.balls, scene.plate, scene.laws(), scene.duration, gravity=scene.gravity, **how
+            scene.balls, scene.plate, scene.contacts(), scene.duration, gravity=scene.gravity, **how
         )
 
 
@@ -159,7 +159,7 @@ def _stream(scene, how, plate=None, reference=False):
 
         extra = {} if plate is None else {"plate": plate}
         return engine.run(
-            particles, scene.incline, scene.duration, laws=scene.contact, rtol=rtol,
+            particles, scene.incline, scene.duration, laws=scene.contacts(), rtol=rtol,
             max_steps=max_steps, progress=advance, **extra,
         )  # fmt: skip
 

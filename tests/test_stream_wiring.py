@@ -21,6 +21,7 @@ from tailbeam.cli import main
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.io.scene_file import dumps_scene, load_scene, loads_scene, tomllib
 from tailbeam.physics.bodies import Plate
+from tailbeam.physics.contacts import LawOptions
 from tailbeam.physics.hertz import hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import COAL, SANDSTONE
@@ -440,12 +441,14 @@ def test_the_fast_solver_plugs_in_by_existing(monkeypatch):
 
     calls = []
     fake = types.ModuleType("tailbeam.solvers.stream.stream")
-    fake.simulate_stream = lambda *args, **kw: calls.append((args, kw)) or "fast result"
+    fast_result = types.SimpleNamespace(info={})  # tailbeam.simulate writes info["solver"]
+    fake.simulate_stream = lambda *args, **kw: calls.append((args, kw)) or fast_result
     fake.MAX_PARTICLES = 10**6
     monkeypatch.setitem(sys.modules, "tailbeam.solvers.stream.stream", fake)
     assert stream_engine().name == "fast stream solver"
     scene = load_scene(SMALL)
-    assert tailbeam.simulate(scene, progress=False) == "fast result"
+    assert tailbeam.simulate(scene, progress=False) is fast_result
     ((args, kw),) = calls
     assert args[0] == scene.particles and args[2] == scene.duration
-    assert kw["laws"] == scene.contact and args[1] == scene.incline
+    assert kw["laws"] is scene.contacts() and args[1] == scene.incline  # the contact table
+    assert kw["laws"].options == LawOptions.of(scene.contact)

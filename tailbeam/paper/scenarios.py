@@ -145,7 +145,7 @@ def run_scenario(
         from tailbeam.solvers.rigid import simulate_rigid as solver  # imported when first needed
 
     scene = SCENARIOS[key].scene(contact, drop_gap=drop_gap, duration=duration)
-    return solver(scene.balls, scene.plate, scene.laws(), scene.duration, **solver_options)
+    return solver(scene.balls, scene.plate, scene.contacts(), scene.duration, **solver_options)
 
 
 def run_all(contact: ContactSettings | None = None, *, drop_gap: float = DROP_GAP, **options):

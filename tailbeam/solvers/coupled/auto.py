@@ -254,7 +254,7 @@ def simulate_scene_modal(scene: Scene, *, basis=None, use_cache: bool = True, **
     result = simulate_coupled(
         scene.balls,
         basis,
-        scene.laws(),
+        scene.contacts(),
         scene.duration,
         sensors=scene.sensors,
         damping_ratio=settings.damping_ratio,

@@ -37,31 +37,29 @@ class CoupledRun:
     ``zeta``: damping ratio per mode; the other settings as in ``simulate_coupled``.
     """
 
-    def __init__(self, balls, basis, laws, duration, *, sensors, zeta, residual_flexibility,
+    def __init__(self, balls, basis, contacts, duration, *, sensors, zeta, residual_flexibility,
                  steps_per_contact, rest_speed, rest_contact_factor, gravity):  # fmt: skip
-        self.balls, self.laws, self.basis, self.duration = balls, laws, basis, duration
+        self.balls, self.table, self.basis, self.duration = balls, contacts, basis, duration
         self.sensors, self.zeta, self.gravity = tuple(sensors), zeta, gravity
         self.residual_flexibility = residual_flexibility
         self.steps_per_contact, self.rest_speed = steps_per_contact, rest_speed
         self.rest_contact_factor = rest_contact_factor
         self.omega = np.ascontiguousarray(basis.omega, dtype=float)
-        self._ball_arrays(balls, laws)
+        self._ball_arrays(balls, contacts)
         self.compliance = Compliance(basis, residual_flexibility)
         # the load model (tailbeam.physics.contact_patch): a point (Kirchhoff) or the Hertz disc
         # (Mindlin)
-        pairs = zip(balls, laws, strict=True)
-        self.rload = [load_radius(basis.theory, b, lw, gravity) for b, lw in pairs]
+        self.rload = [
+            load_radius(basis.theory, b, contacts.law(i, PLATE), gravity)
+            for i, b in enumerate(balls)
+        ]
         self._state(balls)
         self._records(balls)
 
-    def _ball_arrays(self, balls, laws) -> None:
+    def _ball_arrays(self, balls, contacts) -> None:
         self.mass = np.array([b.mass for b in balls])
         self.radius = np.array([b.radius for b in balls])
-        self.kk = np.array([lw.stiffness for lw in laws])
-        self.ee = np.array([lw.exponent for lw in laws])
-        self.cc = np.array([lw.damping for lw in laws])
-        self.dd = np.array([lw.penetration for lw in laws])
-        self.clampf = np.array([lw.clamp for lw in laws], dtype=np.bool_)
+        self.kk, self.ee, self.cc, self.dd, self.clampf = contacts.plate_arrays()
         self.x0 = np.array([b.position[0] for b in balls])
         self.y0 = np.array([b.position[1] for b in balls])
         self.vx = np.array([b.velocity[0] for b in balls])
@@ -253,7 +251,7 @@ class CoupledRun:
         mg = self.balls[b].mass * self.gravity
         w = float(self.phi[b] @ self.q)
         self.mode[b] = S.REST
-        self.z[b] = self.radius[b] - self.laws[b].static_penetration(mg) + w
+        self.z[b] = self.radius[b] - self.table.law(b, PLATE).static_penetration(mg) + w
         self.vz[b] = 0.0
         self.F[b] = mg
         self.cur[:, b] = 0.0
@@ -275,7 +273,7 @@ class CoupledRun:
         n = self.nbuf
         return CoupledResult(
             balls=self.balls,
-            laws=self.laws,
+            laws=self.table.plate_laws(),
             basis=self.basis,
             duration=self.duration,
             gravity=self.gravity,

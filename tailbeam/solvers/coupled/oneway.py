@@ -15,6 +15,7 @@ import numpy as np
 
 from tailbeam.physics.bodies import STANDARD_GRAVITY
 from tailbeam.physics.contact_patch import load_radius
+from tailbeam.physics.contacts import PLATE, contact_table
 from tailbeam.solvers.coupled.result import CoupledResult
 from tailbeam.solvers.rigid import simulate_rigid
 
@@ -32,13 +33,15 @@ def simulate_one_way(
     gravity=STANDARD_GRAVITY,
     points_per_contact: int = 400,
 ) -> CoupledResult:
-    """Rigid-plate impacts (tailbeam.solvers.rigid) whose force histories drive the modal plate."""
+    """Rigid-plate impacts (tailbeam.solvers.rigid) whose force histories drive the modal plate;
+    ``laws``: the balls' ``ContactTable`` or one ball-plate ImpactLaw per ball."""
     from tailbeam.solvers.coupled.solver import modal_damping
 
     kwargs = {} if rest_speed is None else {"rest_speed": rest_speed}
     if gravity != STANDARD_GRAVITY:
         kwargs["gravity"] = gravity
-    rigid = simulate_rigid(balls, basis.plate, laws, duration, **kwargs)
+    contacts = contact_table(balls, laws)
+    rigid = simulate_rigid(balls, basis.plate, contacts, duration, **kwargs)
     # node times: fine inside every contact, the contact limits, rest times, and the ends
     pieces = [np.array([0.0, duration])]
     for imp in rigid.impacts:
@@ -56,13 +59,15 @@ def simulate_one_way(
     force = np.column_stack([states[n]["force"] for n in names])
     delta = np.array([b.radius for b in balls])[None, :] - z
     # the same load model as the two-way solver: a point (Kirchhoff) or the Hertz disc (Mindlin)
-    radii = [load_radius(basis.theory, b, lw, gravity) for b, lw in zip(balls, laws, strict=True)]
+    radii = [
+        load_radius(basis.theory, b, contacts.law(i, PLATE), gravity) for i, b in enumerate(balls)
+    ]
     phi = np.array([basis.load_deflection([balls[i].position[:2]], radii[i])[0]
                     for i in range(len(balls))])  # fmt: skip
     omega = np.asarray(basis.omega)
     return CoupledResult(
         balls=tuple(balls),
-        laws=tuple(laws),
+        laws=contacts.plate_laws(),
         basis=basis,
         duration=duration,
         gravity=rigid.gravity,

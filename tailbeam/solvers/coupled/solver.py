@@ -10,7 +10,7 @@ import numpy as np
 from tailbeam.errors import InputError, require_positive
 from tailbeam.modal import ModalBasis
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, check_ball_above_plate
-from tailbeam.physics.contact_law import ImpactLaw
+from tailbeam.physics.contacts import contact_table
 from tailbeam.solvers.coupled.driver import CoupledRun
 from tailbeam.solvers.coupled.result import CoupledResult
 
@@ -55,15 +55,17 @@ def simulate_coupled(
 ) -> CoupledResult:
     """Balls striking the modal plate ``basis`` over [0, duration] s; see the package docstring.
 
-    laws: one ball-plate ImpactLaw per ball. sensors: SensorSpec accelerometers. Damping: a
+    laws: the balls' ``ContactTable`` (``Scene.contacts()``, tailbeam.physics.contacts) or
+    one ball-plate ImpactLaw per ball. sensors: SensorSpec accelerometers. Damping: a
     ratio per mode (or Rayleigh (alpha 1/s, beta s)). residual_flexibility adds the static
     compliance of the truncated modes in series with each contact. steps_per_contact: steps per
     Hertz contact duration (accuracy, 2nd order). A ball whose rebound is slower than
     ``rest_speed`` (m/s), or that stays in contact longer than rest_contact_factor Hertz
     durations, is declared at rest and then loads the plate with its weight.
     """
-    balls, laws = tuple(balls), tuple(laws)
-    _check_inputs(balls, basis, laws, sensors, residual_flexibility, coupling, steps_per_contact)
+    balls = tuple(balls)
+    laws = _check_inputs(balls, basis, laws, sensors, residual_flexibility, coupling,
+                         steps_per_contact)  # fmt: skip
     duration = require_positive("duration", duration)
     if coupling == "one-way":
         from tailbeam.solvers.coupled.oneway import simulate_one_way
@@ -96,17 +98,15 @@ def simulate_coupled(
 
 
 def _check_inputs(balls, basis, laws, sensors, residual_flexibility, coupling, steps_per_contact):
-    """InputError (one line, naming the setting) for what simulate_coupled cannot run."""
+    """InputError (one line, naming the setting) for what simulate_coupled cannot run;
+    returns the balls' contact table (``laws`` as a ``ContactTable``)."""
     if not balls:
         raise InputError("balls", "need at least one ball")
-    if len(laws) != len(balls):
-        raise InputError("laws", f"need one law per ball: {len(balls)} balls, {len(laws)} laws")
-    for ball, law in zip(balls, laws, strict=True):
+    for ball in balls:
         if not isinstance(ball, Ball):
             raise InputError("balls", "must be Ball objects")
-        if not isinstance(law, ImpactLaw):
-            raise InputError("laws", "must be ImpactLaw objects")
         check_ball_above_plate(ball)
+    contacts = contact_table(balls, laws)
     if coupling not in ("two-way", "one-way"):
         raise InputError("plate.coupling", f"must be 'two-way' or 'one-way', got {coupling!r}")
     if int(steps_per_contact) < 4:
@@ -120,3 +120,4 @@ def _check_inputs(balls, basis, laws, sensors, residual_flexibility, coupling, s
             f"the {basis.theory} {basis.boundary} basis has no static compliance (a plate with "
             "rigid-body modes); set residual_flexibility = false",
         )
+    return contacts

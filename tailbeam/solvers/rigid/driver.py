@@ -47,9 +47,10 @@ class ContactOutcome:
     info: dict = field(default_factory=dict)
 
 
-def run(pairs, plate, balls, laws, duration, integrate_contact, *, max_contacts, max_steps):
+def run(pairs, plate, balls, contacts, duration, integrate_contact, *, max_contacts, max_steps):
     """Simulate all pairs on [0, duration]; ``integrate_contact(pair, v_in, tau_max,
-    max_steps)`` -> ContactOutcome integrates one contact starting at penetration 0."""
+    max_steps)`` -> ContactOutcome integrates one contact starting at penetration 0;
+    ``contacts``: the balls' ``ContactTable`` (their ball-plate laws)."""
     states = []
     heap = []
     for i, p in enumerate(pairs):
@@ -66,12 +67,14 @@ def run(pairs, plate, balls, laws, duration, integrate_contact, *, max_contacts,
     impacts = sorted((imp for st in states for imp in st.impacts), key=lambda m: m.t_start)
     events = sorted((ev for st in states for ev in st.events), key=lambda ev: ev.t)
     trajectories = {
-        st.pair.name: st.builder.build(st.pair.radius, st.pair.mass, law, st.pair.gravity)
-        for st, law in zip(states, laws, strict=True)
+        st.pair.name: st.builder.build(
+            st.pair.radius, st.pair.mass, contacts.law(i, PLATE), st.pair.gravity
+        )
+        for i, st in enumerate(states)
     }
     return RigidResult(
         balls=tuple(balls),
-        laws=tuple(laws),
+        laws=contacts.plate_laws(),
         duration=float(duration),
         gravity=pairs[0].gravity,
         impacts=impacts,

@@ -29,7 +29,7 @@ from functools import cached_property
 from tailbeam.errors import InputError, require_nonnegative, require_positive, require_real
 from tailbeam.physics import impact
 from tailbeam.physics.bodies import Ball, Plate, check_ball_above_plate
-from tailbeam.physics.contact_law import ImpactLaw
+from tailbeam.physics.contacts import PLATE, contact_table
 from tailbeam.physics.hertz import static_penetration
 
 DEFAULT_REST_SPEED = 0.01  # m/s, see the module docstring
@@ -109,51 +109,50 @@ def time_to_contact(gap: float, vz: float, gravity: float) -> tuple:
 
 
 def make_pairs(balls, plate, laws, duration, *, gravity, rest_speed, max_contacts, max_steps):
-    """Validate the inputs of a rigid simulation and return the Pair of each ball."""
+    """Validate the inputs of a rigid simulation and return the Pair of each ball; ``laws``:
+    the balls' ``ContactTable`` or one ball-plate ImpactLaw per ball (``contact_table``)."""
     if not isinstance(plate, Plate):
         raise InputError("plate", "must be a Plate")
     try:
         balls = tuple(balls)
-        laws = tuple(laws)
     except TypeError:
-        raise InputError("balls", "balls and laws must be sequences") from None
+        raise InputError("balls", "must be a sequence of Ball") from None
     if not balls:
         raise InputError("balls", "must contain at least one Ball")
-    if len(laws) != len(balls):
-        raise InputError("laws", f"need one ImpactLaw per ball: {len(balls)} balls, {len(laws)}")
     names = set()
-    for i, (ball, law) in enumerate(zip(balls, laws, strict=True)):
+    for i, ball in enumerate(balls):
         if not isinstance(ball, Ball):
             raise InputError(f"balls[{i}]", "must be a Ball")
-        if not isinstance(law, ImpactLaw):
-            raise InputError(f"laws[{i}]", "must be an ImpactLaw")
         if ball.name in names:
             raise InputError(f"balls[{i}].name", f"duplicate ball name {ball.name!r}")
         names.add(ball.name)
         check_ball_above_plate(ball, plate)
+    contacts = contact_table(balls, laws)
     require_positive("duration", duration)
     g = require_nonnegative("gravity", gravity)
     rs = require_nonnegative("rest_speed", rest_speed)
     for fname, value in (("max_contacts", max_contacts), ("max_steps", max_steps)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise InputError(fname, f"must be a positive integer, got {value!r}")
-    return [
-        Pair(
-            ball.name,
-            ball.radius,
-            ball.mass,
-            law.stiffness,
-            law.exponent,
-            law.damping,
-            law.penetration,
-            law.clamp,
-            g,
-            rs,
-            ball.position,
-            ball.velocity,
-        )
-        for ball, law in zip(balls, laws, strict=True)
-    ]
+    return [_pair(ball, contacts.law(i, PLATE), g, rs) for i, ball in enumerate(balls)]
+
+
+def _pair(ball, law, gravity: float, rest_speed: float) -> Pair:
+    """The Pair of ``ball`` with its ball-plate ``law`` (gravity m/s^2, rest_speed m/s)."""
+    return Pair(
+        ball.name,
+        ball.radius,
+        ball.mass,
+        law.stiffness,
+        law.exponent,
+        law.damping,
+        law.penetration,
+        law.clamp,
+        gravity,
+        rest_speed,
+        ball.position,
+        ball.velocity,
+    )
 
 
 def check_rtol(rtol: float) -> float:

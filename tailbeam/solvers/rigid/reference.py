@@ -17,6 +17,7 @@ from scipy.integrate import solve_ivp
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics import impact
 from tailbeam.physics.bodies import STANDARD_GRAVITY
+from tailbeam.physics.contacts import contact_table
 from tailbeam.solvers.records import EventKind
 from tailbeam.solvers.rigid import driver
 from tailbeam.solvers.rigid.model import (
@@ -67,7 +68,7 @@ def simulate_rigid_reference(
         pairs,
         plate,
         balls,
-        laws,
+        contact_table(balls, laws),
         duration,
         integrate,
         max_contacts=max_contacts,

@@ -12,6 +12,7 @@ import numpy as np
 
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics.bodies import STANDARD_GRAVITY
+from tailbeam.physics.contacts import contact_table
 from tailbeam.solvers.rigid import driver, kernel
 from tailbeam.solvers.rigid.model import (
     DEFAULT_MAX_CONTACTS,
@@ -41,7 +42,8 @@ def simulate_rigid(
     max_steps=DEFAULT_MAX_STEPS,
 ):
     """Simulate ``balls`` (sequence of Ball) dropping on a rigid ``plate`` (Plate) on
-    [0, ``duration``] s; ``laws``: one ball-plate ImpactLaw per ball.
+    [0, ``duration``] s; ``laws``: the balls' ``ContactTable`` (``Scene.contacts()``,
+    tailbeam.physics.contacts) or one ball-plate ImpactLaw per ball.
 
     rtol: relative tolerance of the contact integration (errors in peak force, restitution
     and apex height come out near rtol); gravity in m/s^2; rest_speed in m/s (see
@@ -64,7 +66,7 @@ def simulate_rigid(
         pairs,
         plate,
         balls,
-        laws,
+        contact_table(balls, laws),
         duration,
         integrator,
         max_contacts=max_contacts,

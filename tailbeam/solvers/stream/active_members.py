@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-from tailbeam.physics.contact_law import ball_ball_law
 from tailbeam.physics.contact_patch import load_radius
+from tailbeam.physics.contacts import PLATE
 from tailbeam.physics.incline import EDGES
 from tailbeam.solvers.stream.active_pairs import L_CRES, first_contact_step, settle_excess
 from tailbeam.solvers.stream.active_set import ActiveSet, law_table
@@ -30,8 +30,8 @@ _KIND = {"contact_start": "start", "contact_end": "end", "leave": "leave", "sett
 class ActiveMembers:
     """Members (ball numbers of ``balls``: a ``stream_state.Balls``) and their pairs."""
 
-    def __init__(self, balls, options, rtol, settle_energy, plate=None, dead_loads=None):
-        self.balls, self.options, self.rtol = balls, options, rtol
+    def __init__(self, balls, rtol, settle_energy, plate=None, dead_loads=None):
+        self.balls, self.rtol = balls, rtol  # balls.table: the laws of the pairs
         self.plate = plate  # a StreamPlate (two-way modal plate) or None (rigid)
         self.dead_loads = dead_loads  # () -> (xy (p, 2), weights (p,)) of resting non-members
         self.now = 0.0  # the driver's time (s), where a rebuilt set starts
@@ -42,7 +42,6 @@ class ActiveMembers:
         self.set = None
         self.dirty = True
         self.h = 0.0
-        self._laws = {}
         self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
         self.totals = {"kernel_steps": 0, "kernel_attempts": 0, "kernel_nfev": 0, "rebuilds": 0}
         self._shape_cache = {}  # ball -> (xy, mode shapes there): modal plate
@@ -84,17 +83,6 @@ class ActiveMembers:
         s = self.set
         return (s.touching[p], s.ramp[p], s.clamped[p], s.peak[p], s.t_peak[p], s.pen[p])
 
-    def _law(self, i, j):
-        key = (i, j)
-        if key not in self._laws:
-            b = self.balls
-            pi, pj = b.particles[i], b.particles[j]
-            law = ball_ball_law(
-                pi.material, pi.radius, pj.material, pj.radius, **self.options.kwargs()
-            )
-            self._laws[key] = law
-        return self._laws[key]
-
     def _build(self):
         b, m = self.balls, self.members
         old = getattr(self, "_pairs", {}) if self.set is not None else {}
@@ -103,7 +91,7 @@ class ActiveMembers:
         ]
         local = {i: q for q, i in enumerate(m)}
         pairs = [(local[i], -1 if j < 0 else local[j]) for i, j in self.keys]
-        laws = [b.plate_laws[i] if j < 0 else self._law(i, j) for i, j in self.keys]
+        laws = [b.table.law(i, PLATE if j < 0 else j) for i, j in self.keys]
         settle = [0.0 if i in self.quiet else self.settle_energy(i) for i in m]
         self._count()
         self.set = ActiveSet(
@@ -163,7 +151,7 @@ class ActiveMembers:
         if i not in self._load_radii:
             b = self.balls
             self._load_radii[i] = load_radius(self.plate.basis.theory, b.particles[i].ball(),
-                                              b.plate_laws[i], float(-b.g[2]))  # fmt: skip
+                                              b.plate_law(i), float(-b.g[2]))  # fmt: skip
         return self._load_radii[i]
 
     def refresh_shapes(self):

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.physics.contact_law import ball_ball_law, ball_plate_law
+from tailbeam.physics.contacts import PLATE, ContactTable, LawOptions
 from tailbeam.solvers.rigid.kernel import dop853_tables
 from tailbeam.solvers.stream import active_kernel as ak
 from tailbeam.solvers.stream.active_pairs import (
@@ -76,17 +76,11 @@ def law_table(laws) -> np.ndarray:
 
 
 def pair_laws(balls, pairs, plate_material, **options):
-    """Laws of ``pairs`` ((i, j), j = -1 the plate) of ``balls`` (tailbeam.Ball), from
-    ``ball_ball_law`` / ``ball_plate_law`` with the IMPACT ``options``."""
-    laws = []
-    for i, j in pairs:
-        a = balls[i]
-        if j < 0:
-            laws.append(ball_plate_law(a.material, a.radius, plate_material, **options))
-        else:
-            b = balls[j]
-            laws.append(ball_ball_law(a.material, a.radius, b.material, b.radius, **options))
-    return laws
+    """Laws of ``pairs`` ((i, j), j = -1 the plate) of ``balls`` (tailbeam.Ball): their rows
+    of the balls' contact table (``tailbeam.physics.contacts``) with the IMPACT ``options``
+    (exponent, damping, penetration, clamp)."""
+    table = ContactTable.from_settings(balls, plate_material, LawOptions(**options))
+    return [table.law(i, PLATE if j < 0 else j) for i, j in pairs]
 
 
 class ActiveSet:

@@ -4,7 +4,8 @@
 that module exists, else the slow reference (``simulate_stream_reference``, every pair
 watched, fine for 3-10 balls, refused beyond ``REFERENCE_MAX_PARTICLES``). Both are called
 as ``run(particles, incline, duration, *, laws, rtol, max_steps, progress)`` and return a
-``StreamResult``; ``laws`` carries the IMPACT settings shared by every pair (exponent,
+``StreamResult``; ``laws`` is the particles' contact table (``Scene.contacts()``,
+``tailbeam.physics.contacts``) or the IMPACT settings shared by every pair (exponent,
 damping, penetration, clamp: ``tailbeam.scene.ContactSettings``).
 
 The fast solver plugs in by existing: a module ``tailbeam/solvers/stream/stream.py`` with
@@ -16,6 +17,7 @@ import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from tailbeam.physics.contacts import contact_table
 from tailbeam.solvers.stream.stream_result import StreamResult
 
 FAST_MODULE = "tailbeam.solvers.stream.stream"
@@ -91,10 +93,7 @@ def run_reference(particles, incline, duration, *, laws, rtol, max_steps, progre
         [p.ball() for p in particles],
         incline,
         duration,
-        damping=laws.damping,
-        penetration=laws.penetration,
-        clamp=laws.clamp,
-        exponent=laws.exponent,
+        contacts=contact_table(particles, laws, incline.plate.material),
         rtol=rtol,
         max_steps=max_steps,
         release_times=[p.t_release for p in particles],

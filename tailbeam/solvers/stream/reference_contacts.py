@@ -1,6 +1,6 @@
 """The stream reference's bookkeeping: pairs, contacts, leaves and releases (a mixin of
 ``tailbeam.solvers.stream.stream_reference._Reference``, which provides ``balls``, ``mass``,
-``incline``, ``options``, ``plate``, ``rtol``, ``active``, ``waiting``, ``pairs``, ``t``,
+``incline``, ``table``, ``plate``, ``rtol``, ``active``, ``waiting``, ``pairs``, ``t``,
 ``y``, ``contacts``, ``leaves``, ``events`` and the state layout of ``reference_state``).
 
 Every pair is a ``_Pair`` (ball-ball or ball-plate: its law, its region flags, its open
@@ -16,8 +16,6 @@ import numpy as np
 
 from tailbeam.physics.contact_law import (
     ImpactLaw,
-    ball_ball_law,
-    ball_plate_law,
     clamp_indicator,
 )
 from tailbeam.physics.hertz import hertz_max_penetration
@@ -162,13 +160,13 @@ class ReferenceContacts:
     def add_pairs(self, i):
         """Create the pairs of ball i with the plate and with every other active ball."""
         a, made = self.balls[i], []
-        law = ball_plate_law(a.material, a.radius, self.incline.plate.material, **self.options)
+        law = self.table.law(i, PLATE)
         made.append(self.pairs.setdefault((i, -1), _Pair(i, -1, law, a.radius)))
         for j in self.active:
             if j != i:
                 lo, hi = min(i, j), max(i, j)
                 b, c = self.balls[lo], self.balls[hi]
-                law = ball_ball_law(b.material, b.radius, c.material, c.radius, **self.options)
+                law = self.table.law(lo, hi)
                 pair = _Pair(lo, hi, law, b.radius + c.radius)
                 made.append(self.pairs.setdefault((lo, hi), pair))
         return made

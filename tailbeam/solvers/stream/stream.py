@@ -38,6 +38,7 @@ import numpy as np
 
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.contact_law import HERTZ_EXPONENT
+from tailbeam.physics.contacts import contact_table
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import note, quiet, task
 from tailbeam.solvers.stream.stream_heap import _EPOCH, _RELEASE, StreamHeap
@@ -77,15 +78,16 @@ def simulate_stream(
 ):  # fmt: skip
     """The stream solver as ``tailbeam.solvers.stream.engine`` calls it: a ``StreamResult``.
 
-    laws: the IMPACT settings shared by every pair (``tailbeam.scene.ContactSettings``:
-    exponent, damping, penetration, clamp). progress: True (a bar), False, or a callable
-    taking the simulated time reached (s)."""
+    laws: the particles' ``ContactTable`` (``Scene.contacts()``) or the IMPACT settings
+    shared by every pair (``tailbeam.scene.ContactSettings``: exponent, damping,
+    penetration, clamp). progress: True (a bar), False, or a callable taking the simulated
+    time reached (s)."""
     from tailbeam.solvers.stream.stream_result import StreamResult
 
+    contacts = contact_table(particles, laws, incline.plate.material)
     run = solve_stream(
-        particles, incline, duration, damping=laws.damping, penetration=laws.penetration,
-        clamp=laws.clamp, exponent=laws.exponent, rtol=rtol, rest_speed=rest_speed,
-        max_work=max_steps, progress=progress, plate=plate,
+        particles, incline, duration, rtol=rtol, rest_speed=rest_speed,
+        max_work=max_steps, progress=progress, plate=plate, contacts=contacts,
     )  # fmt: skip
     result = StreamResult(
         run.particles, run.contacts, run.leaves, run.events, incline, duration,
@@ -117,23 +119,27 @@ def solve_stream(
     max_work: int = DEFAULT_MAX_STEPS,
     progress=True,
     plate=None,
+    contacts=None,
 ) -> StreamRun:
     """Simulate ``particles`` (``tailbeam.streams.generator.Particle``: released at their
     t_release with their position and velocity, plate frame) on ``incline`` for ``duration``
     s. IMPACT parameters shared by every pair (stiffness from Hertz for each pair); rtol: the
     kernel's relative tolerance; rest_speed (m/s): see the module docstring; max_work: bound
     on kernel steps plus events (WorkLimitError beyond); plate: a ``StreamPlate`` (the modal
-    plate, two-way) or None (the rigid plate)."""
+    plate, two-way) or None (the rigid plate); contacts: the particles' ``ContactTable``
+    (its settings then replace the IMPACT parameters given here)."""
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-4:
         raise InputError("rtol", f"must lie in [1e-14, 1e-4], got {rtol!r}")
     if rest_speed < 0:
         raise InputError("rest_speed", f"must be >= 0, got {rest_speed!r}")
-    options = LawOptions(exponent, damping, penetration, clamp)
+    if contacts is None:
+        contacts = LawOptions(exponent, damping, penetration, clamp)
+    contacts = contact_table(particles, contacts, incline.plate.material)
     for attempt in range(GRAZING_RETRIES + 1):
         if plate is not None:
             plate.reset()
-        sim = _Stream(particles, incline, duration, options, rtol, rest_speed, max_work, plate)
+        sim = _Stream(particles, incline, duration, contacts, rtol, rest_speed, max_work, plate)
         try:
             run = _run(sim, duration, progress)
         except _Stuck as err:
@@ -176,15 +182,15 @@ class _CallbackBar:
 class _Stream(StreamHeap, StreamSetEvents, StreamMembership, StreamRecords):
     """The event loop; see the module docstring."""
 
-    def __init__(self, particles, incline, duration, options, rtol, rest_speed, max_events, plate):
+    def __init__(self, particles, incline, duration, contacts, rtol, rest_speed, max_events, plate):
         from tailbeam.solvers.stream.active_members import ActiveMembers
 
-        self.balls = Balls(particles, incline, options)
-        self.incline, self.duration, self.options = incline, duration, options
+        self.balls = Balls(particles, incline, contacts)
+        self.incline, self.duration = incline, duration
         self.rest_speed, self.max_events = rest_speed, max_events
         self.plate = plate
         self.act = ActiveMembers(
-            self.balls, options, rtol, self._settle_energy, plate, self._resting_outside
+            self.balls, rtol, self._settle_energy, plate, self._resting_outside
         )
         self.landing = set()  # modal plate: balls within the deflection bound, touching nothing
         self.hold = {}  # ball -> time of a contact end: core until time moves on

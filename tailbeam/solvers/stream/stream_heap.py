@@ -70,7 +70,7 @@ class StreamHeap:
             return
         b.set_motion(i, FLY, self.t, b.x0[i].copy(), b.v0[i].copy())
         x, v = b.state(i, self.t)
-        on_plate = float(elastic_energy(b.radius[i] - x[2], b.plate_laws[i]))  # released there
+        on_plate = float(elastic_energy(b.radius[i] - x[2], b.plate_law(i)))  # released there
         self.stats["energy_released"] += self._ball_energy(i, x, v) + on_plate
         self.events.append(Event(self.t, b.names[i], EventKind.RELEASE, ""))
         self._predict(i)

@@ -55,7 +55,7 @@ class StreamRecords:
 
     def _hertz_duration(self, i: int, speed: float) -> float:
         """Hertz contact duration (s) of ball i on the plate at ``speed`` (>= rest_speed)."""
-        law = self.balls.plate_laws[i]
+        law = self.balls.plate_law(i)
         speed = max(speed, self.rest_speed, 1e-3)
         return hertz_contact_duration(self.balls.mass[i], speed, law.stiffness, law.exponent)
 
@@ -106,7 +106,7 @@ class StreamRecords:
         if i not in self.act.members:
             if self.balls.status[i] != SLIDE:
                 return 0.0
-            return float(elastic_energy(self.balls.static_pen[i], self.balls.plate_laws[i]))
+            return float(elastic_energy(self.balls.static_pen[i], self.balls.plate_law(i)))
         return self.act.elastic_energy_of(i)
 
     def _final_energy(self) -> float:

@@ -7,7 +7,8 @@ step through its ``OdeSolver`` class so that every step can be checked for conta
 1e-12 by default). Every pair is watched (O(N^2): this is the slow reference):
 
 * ball-ball and ball-plate contacts use the IMPACT law of ``tailbeam.physics.contact_law``
-  (``ball_ball_law``: R = R1 R2 / (R1 + R2), E* of both materials; ``ball_plate_law``), the
+  (from the contact table, ``tailbeam.physics.contacts``: ball-ball R = R1 R2 / (R1 + R2),
+  E* of both materials; ball-plate), the
   pair geometry of ``tailbeam.physics.pair`` and the plate frame of
   ``tailbeam.physics.incline`` (gravity g (sin theta, 0, -cos theta));
 * events at every kink: contact start and end of every pair, penetration = d (STEP kink,
@@ -48,6 +49,7 @@ from scipy.integrate import DOP853
 
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.contact_law import HERTZ_EXPONENT
+from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.solvers.stream.reference_contacts import ReferenceContacts
 from tailbeam.solvers.stream.reference_events import ReferenceEvents
@@ -96,6 +98,7 @@ def simulate_stream_reference(
     release_times=None,
     progress=None,
     plate: ReferencePlate | None = None,
+    contacts=None,
 ) -> StreamReferenceResult:
     """Integrate ``balls`` (``tailbeam.Ball``, positions and velocities in the plate frame)
     on ``incline`` for ``duration`` s; see the module docstring.
@@ -107,12 +110,13 @@ def simulate_stream_reference(
     its given position and velocity (event ``release``; the energy series jumps there).
     progress: optional callable, called with the time (s) reached after every accepted step.
     plate: a ``ReferencePlate`` (the modal plate, two-way,
-    ``tailbeam.solvers.stream.reference_plate``) or None (the rigid plate).
+    ``tailbeam.solvers.stream.reference_plate``) or None (the rigid plate). contacts: the
+    balls' ``ContactTable`` (its settings then replace the IMPACT parameters given here).
     """
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-3:
         raise InputError("rtol", f"must lie in [1e-14, 1e-3], got {rtol!r}")
-    options = dict(exponent=exponent, damping=damping, penetration=penetration, clamp=clamp)
+    options = LawOptions(exponent, damping, penetration, clamp) if contacts is None else contacts
     balls = list(balls)
     release = _release_times(release_times, len(balls))
     if plate is not None:
@@ -135,7 +139,7 @@ class _Reference(ReferenceState, ReferenceEvents, ReferenceContacts, ReferenceSt
         self.balls, self.incline, self.rtol, self.max_steps = balls, incline, rtol, max_steps
         self.g = incline.gravity_vector
         self.mass = np.array([b.mass for b in balls])
-        self.options = options
+        self.table = contact_table(balls, options, incline.plate.material)  # the pairs' laws
         self.active = [i for i in range(len(balls)) if release[i] <= 0.0]
         self.waiting = sorted((float(release[i]), i) for i in range(len(balls)) if release[i] > 0)
         self.pairs = {}

@@ -8,38 +8,19 @@ that motion, so predictions made for an older motion are recognised as stale.
 """
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from tailbeam.physics.contact_law import ball_plate_law
+from tailbeam.physics.contacts import PLATE, LawOptions  # noqa: F401 (LawOptions: re-exported)
 from tailbeam.solvers.stream.flight import advance, band_time, edge_time, pair_time, plate_time
 
 PENDING, FLY, SLIDE, ACTIVE, GONE = range(5)
 
 
-@dataclass(frozen=True)
-class LawOptions:
-    """IMPACT parameters shared by every pair: exponent, damping c (N s/m), d (m), clamp."""
-
-    exponent: float
-    damping: float
-    penetration: float
-    clamp: bool
-
-    def kwargs(self) -> dict:
-        return {
-            "exponent": self.exponent,
-            "damping": self.damping,
-            "penetration": self.penetration,
-            "clamp": self.clamp,
-        }
-
-
 class Balls:
     """Per-ball arrays of a stream (n balls, in release order)."""
 
-    def __init__(self, particles, incline, options: LawOptions):
+    def __init__(self, particles, incline, contacts):
         self.particles = list(particles)
         n = len(self.particles)
         self.names = [p.name for p in self.particles]
@@ -55,16 +36,16 @@ class Balls:
         self.g = np.asarray(incline.gravity_vector, dtype=float)
         self.g_slide = np.array([self.g[0], self.g[1], 0.0])
         self.half = incline.half_sizes
-        plate_material = incline.plate.material
-        self.plate_laws = [
-            ball_plate_law(p.material, p.radius, plate_material, **options.kwargs())
-            for p in self.particles
-        ]
+        self.table = contacts  # the ContactTable of the particles (tailbeam.physics.contacts)
         weight_n = self.mass * max(-self.g[2], 0.0)
         self.static_pen = np.array(
-            [lw.static_penetration(w) for lw, w in zip(self.plate_laws, weight_n, strict=True)]
+            [self.plate_law(i).static_penetration(w) for i, w in enumerate(weight_n)]
         )
         self.slide_since = np.full(n, math.nan)
+
+    def plate_law(self, i: int):
+        """The ball-plate law of ball i (its row in the contact table)."""
+        return self.table.law(i, PLATE)
 
     def accel(self, i: int) -> np.ndarray:
         return self.g_slide if self.status[i] == SLIDE else self.g
