@@ -62,12 +62,19 @@ def configure_numba_cache() -> Path:
     return folder
 
 
+# First-run compile time of each solver's kernels, measured on the 2-core machine (stop 15:
+# examples two_balls_rigid, modal_plate, small_stream with an empty cache, minus a cached run)
+COMPILE_SECONDS = {"rigid": "~10 s", "coupled": "~30 s", "stream": "~25 s"}
+
+
 def announce_first_compile(solver: str = "rigid") -> None:
     """Say so (tailbeam.progress.note) when numba's cache holds no compiled kernel of
     ``solver`` (``"rigid"``, ``"coupled"`` or ``"stream"``, numba names its cache folders after the
-    source folder): the first run compiles them (10-20 s), later runs load them from the cache."""
+    source folder): the first run compiles them (COMPILE_SECONDS), later runs load them from the
+    cache."""
     folder = Path(os.environ.get("NUMBA_CACHE_DIR") or numba_cache_dir())
     if not any(folder.glob(f"{solver}*/*.nbi")):
         from tailbeam.progress import note
 
-        note(f"first run: compiling the contact kernels with numba (10-20 s, cached in {folder})")
+        took = COMPILE_SECONDS.get(solver, "10-30 s")
+        note(f"first run: compiling the contact kernels with numba ({took}, cached in {folder})")
