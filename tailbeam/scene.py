@@ -15,7 +15,7 @@ from tailbeam.errors import (
 )
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, Plate
 from tailbeam.physics.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
-from tailbeam.physics.contacts import ContactTable
+from tailbeam.physics.contacts import PLATE, ContactTable
 from tailbeam.physics.materials import Material
 from tailbeam.signals.noise import NoiseSpec
 
@@ -232,6 +232,12 @@ class Scene:
         dup = {n for n in names if names.count(n) > 1}
         if dup:
             raise InputError("balls", f"ball names must be unique; repeated: {sorted(dup)}")
+        if PLATE in names:
+            raise InputError(
+                f"balls[{names.index(PLATE) + 1}].name",
+                f"{PLATE!r} names the plate (the partner column of impacts.csv, the contact "
+                "table); choose another name",
+            )
         self._check_labels()
         self._check_streams()
         sensor_names = [s.name for s in self.sensors]

@@ -157,3 +157,10 @@ def test_simulate_passes_the_scene_table(monkeypatch):
     tailbeam.simulate(scene, progress=False)
     assert seen == [scene.contacts()]
     assert LawOptions.of(SETTINGS) == scene.contacts().options
+
+
+def test_a_ball_may_not_be_named_plate():
+    # "plate" is the plate's name as a partner (impacts.csv) and as a body of the table
+    balls = (Ball("a", COAL, 0.02, (0.0, 0.0, 0.05)), Ball(PLATE, COAL, 0.02, (0.1, 0.0, 0.05)))
+    with pytest.raises(InputError, match=r"^balls\[2\]\.name: 'plate' names the plate"):
+        Scene(balls)

@@ -21,7 +21,7 @@ import numpy as np
 from tailbeam.errors import InputError
 from tailbeam.physics.contact_law import ImpactLaw, ball_ball_law, ball_plate_law
 
-PLATE = "plate"  # the plate as a body of a pair (the value of tailbeam.solvers.records.PLATE)
+PLATE = "plate"  # the plate as a body of a pair, and the partner name of a ball-plate contact
 
 
 @dataclass(frozen=True)

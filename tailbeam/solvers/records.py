@@ -13,7 +13,7 @@ from dataclasses import dataclass, fields
 from enum import Enum
 from typing import NamedTuple
 
-PLATE = "plate"  # the partner name of a ball-plate contact
+from tailbeam.physics.contacts import PLATE  # the partner name of a ball-plate contact
 
 
 class EventKind(str, Enum):
