@@ -20,8 +20,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tailbeam.errors import WorkLimitError
+from tailbeam.physics.contacts import contact_table
 from tailbeam.solvers.records import PLATE, Event, EventKind, Impact
-from tailbeam.solvers.rigid.model import Pair, time_to_contact
+from tailbeam.solvers.rigid.model import Pair, make_pairs, time_to_contact
 from tailbeam.solvers.rigid.result import RigidResult
 from tailbeam.solvers.rigid.trajectory import TrajectoryBuilder
 
@@ -45,6 +46,21 @@ class ContactOutcome:
     nfev: int
     n_steps: int
     info: dict = field(default_factory=dict)
+
+
+def simulate_balls(balls, plate, laws, duration, integrate_contact, *, gravity, rest_speed,
+                   max_contacts, max_steps) -> RigidResult:  # fmt: skip
+    """The rigid solvers' common part (``simulate_rigid`` and its reference): check the
+    inputs, make each ball's Pair (``make_pairs``) and ``run`` them with the solver's own
+    ``integrate_contact``; ``laws`` as ``make_pairs`` takes them."""
+    pairs = make_pairs(
+        balls, plate, laws, duration, gravity=gravity, rest_speed=rest_speed,
+        max_contacts=max_contacts, max_steps=max_steps,
+    )  # fmt: skip
+    return run(
+        pairs, plate, balls, contact_table(balls, laws), duration, integrate_contact,
+        max_contacts=max_contacts, max_steps=max_steps,
+    )  # fmt: skip
 
 
 def run(pairs, plate, balls, contacts, duration, integrate_contact, *, max_contacts, max_steps):

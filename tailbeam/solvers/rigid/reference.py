@@ -17,7 +17,6 @@ from scipy.integrate import solve_ivp
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics import impact
 from tailbeam.physics.bodies import STANDARD_GRAVITY
-from tailbeam.physics.contacts import contact_table
 from tailbeam.solvers.records import EventKind
 from tailbeam.solvers.rigid import driver
 from tailbeam.solvers.rigid.model import (
@@ -25,7 +24,6 @@ from tailbeam.solvers.rigid.model import (
     DEFAULT_MAX_STEPS,
     DEFAULT_REST_SPEED,
     check_rtol,
-    make_pairs,
 )
 
 CHUNK = 400.0  # integrate at most this many contact time scales per solve_ivp call
@@ -50,30 +48,14 @@ def simulate_rigid_reference(
 ):
     """Same contract as ``simulate_rigid``; slow (pure scipy), for verification."""
     rtol = check_rtol(rtol)
-    pairs = make_pairs(
-        balls,
-        plate,
-        laws,
-        duration,
-        gravity=gravity,
-        rest_speed=rest_speed,
-        max_contacts=max_contacts,
-        max_steps=max_steps,
-    )
 
     def integrate(pair, v_in, tau_max, steps_left):
         return _Contact(pair, rtol).run(v_in, tau_max, steps_left)
 
-    result = driver.run(
-        pairs,
-        plate,
-        balls,
-        contact_table(balls, laws),
-        duration,
-        integrate,
-        max_contacts=max_contacts,
-        max_steps=max_steps,
-    )
+    result = driver.simulate_balls(
+        balls, plate, laws, duration, integrate, gravity=gravity, rest_speed=rest_speed,
+        max_contacts=max_contacts, max_steps=max_steps,
+    )  # fmt: skip
     result.info["solver"] = f"reference: scipy solve_ivp DOP853 rtol={rtol:g}, restarted at kinks"
     return result
 

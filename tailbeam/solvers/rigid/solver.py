@@ -12,14 +12,12 @@ import numpy as np
 
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics.bodies import STANDARD_GRAVITY
-from tailbeam.physics.contacts import contact_table
 from tailbeam.solvers.rigid import driver, kernel
 from tailbeam.solvers.rigid.model import (
     DEFAULT_MAX_CONTACTS,
     DEFAULT_MAX_STEPS,
     DEFAULT_REST_SPEED,
     check_rtol,
-    make_pairs,
 )
 
 _STATUS = {
@@ -51,27 +49,11 @@ def simulate_rigid(
     ball; max_steps: integrator steps per ball. Returns a RigidResult.
     """
     rtol = check_rtol(rtol)
-    pairs = make_pairs(
-        balls,
-        plate,
-        laws,
-        duration,
-        gravity=gravity,
-        rest_speed=rest_speed,
-        max_contacts=max_contacts,
-        max_steps=max_steps,
-    )
     integrator = _KernelIntegrator(rtol)
-    result = driver.run(
-        pairs,
-        plate,
-        balls,
-        contact_table(balls, laws),
-        duration,
-        integrator,
-        max_contacts=max_contacts,
-        max_steps=max_steps,
-    )
+    result = driver.simulate_balls(
+        balls, plate, laws, duration, integrator, gravity=gravity, rest_speed=rest_speed,
+        max_contacts=max_contacts, max_steps=max_steps,
+    )  # fmt: skip
     result.info["solver"] = f"tailbeam DOP853 (numba) rtol={rtol:g}, restarted at kinks"
     return result
 
