@@ -37,7 +37,8 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
         What to simulate (e.g. from ``tailbeam.io.scene_file.load_scene``).
     solver : str
         Which solver runs it, one of ``SOLVERS`` (module docstring); ``"auto"`` by default.
-        The choice is in ``result.info["solver"]``.
+        The choice is in ``result.info["solver_choice"]``; ``result.info["solver"]`` keeps
+        the chosen solver's own description (method, tolerance).
     rtol : float, optional
         Relative tolerance of the solver (rigid: its default 1e-10; stream reference 1e-10).
     max_steps : int, optional
@@ -68,7 +69,7 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
             result.labels = scene.labels  # the scene's coal / gangue labels of its balls
         else:
             result = _through_stream(scene, how, method == "stream-reference")
-    result.info["solver"] = method
+    result.info["solver_choice"] = method
     return result
 
 

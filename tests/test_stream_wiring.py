@@ -441,7 +441,7 @@ def test_the_fast_solver_plugs_in_by_existing(monkeypatch):
 
     calls = []
     fake = types.ModuleType("tailbeam.solvers.stream.stream")
-    fast_result = types.SimpleNamespace(info={})  # tailbeam.simulate writes info["solver"]
+    fast_result = types.SimpleNamespace(info={})  # tailbeam.simulate writes info["solver_choice"]
     fake.simulate_stream = lambda *args, **kw: calls.append((args, kw)) or fast_result
     fake.MAX_PARTICLES = 10**6
     monkeypatch.setitem(sys.modules, "tailbeam.solvers.stream.stream", fake)
