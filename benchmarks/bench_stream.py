@@ -128,16 +128,25 @@ def _worst(a: dict, b: dict) -> float:
     return max(abs(a[k] - b[k]) / abs(b[k]) for k in common)
 
 
-def first_impacts(a: dict, b: dict) -> dict:
+def first_impacts(a: dict, b: dict, within: float = 1e-6) -> dict:
     """First plate impacts of two runs of one stream. A stream is chaotic: a tiny difference
     changes which balls meet in flight, and then everything after. So compare the particles
-    whose first plate impact starts at the same time (1e-6 s) in both runs and came before
-    any ball-ball contact of theirs (the impact itself, not the history), and count the rest."""
+    whose first plate impact starts at the same time (``within`` s) in both runs and came
+    before any ball-ball contact of theirs (the impact itself, not the history), and count
+    the rest. With 1e-6 s the plate under the landing ball is nearly where it is in the other
+    run (a start 1e-6 s apart is ~3 um of plate at 3 m/s); with 1e-3 s the plate's state
+    there may differ (the runs' histories parted): that spread is the chaos, not the band."""
     same = [k for k in set(a) & set(b)
-            if not a[k][2] and not b[k][2] and abs(a[k][1] - b[k][1]) < 1e-6]  # fmt: skip
+            if not a[k][2] and not b[k][2] and a[k][0] > 0 and b[k][0] > 0
+            and abs(a[k][1] - b[k][1]) < within]  # fmt: skip
     errors = np.array([abs(a[k][0] - b[k][0]) / b[k][0] for k in same])
-    return {"compared": len(same), "particles": len(b), "worst": float(errors.max()),
-            "median": float(np.median(errors))}  # fmt: skip
+    return {
+        "compared": len(same),
+        "particles": len(b),
+        "worst": float(errors.max()),
+        "median": float(np.median(errors)),
+        "within_1pct": float(np.mean(errors < 0.01)),
+    }
 
 
 def modal_rows(out_dir: Path, top: float) -> tuple[list, dict]:
@@ -168,18 +177,24 @@ def modal_rows(out_dir: Path, top: float) -> tuple[list, dict]:
     bands = {}
     for name, (a, b) in compared.items():
         peaks = first_impacts(runs[a]["first_peaks"], runs[b]["first_peaks"])
-        bands[name] = dict(peaks, rms=_worst(runs[a]["sensor_rms"], runs[b]["sensor_rms"]),
+        loose = first_impacts(runs[a]["first_peaks"], runs[b]["first_peaks"], within=1e-3)
+        bands[name] = dict(peaks, loose=loose,
+                           rms=_worst(runs[a]["sensor_rms"], runs[b]["sensor_rms"]),
                            rms_a=runs[a]["sensor_rms"], rms_b=runs[b]["sensor_rms"])  # fmt: skip
     return rows, bands
 
 
 def band_lines(bands: dict) -> list:
-    lines = ["", "| two-way modal plate, bands | first-impact peaks compared | median | worst "
-             "| sensor RMS (worst of S1, S2) |", "|---|---|---|---|---|"]  # fmt: skip
+    lines = ["", "| two-way modal plate, bands | first-impact peaks compared (start within 1 us) "
+             "| median | worst | within 1 % | compared (start within 1 ms) | median | worst "
+             "| within 1 % | sensor RMS (worst of S1, S2) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for name, b in bands.items():
+        lo = b["loose"]
         lines.append(
             f"| {name} | {b['compared']} of {b['particles']} | {b['median']:.2e} | "
-            f"{b['worst']:.2e} | {b['rms']:.2e} |"
+            f"{b['worst']:.2e} | {b['within_1pct']:.0%} | {lo['compared']} | "
+            f"{lo['median']:.2e} | {lo['worst']:.2e} | {lo['within_1pct']:.0%} | {b['rms']:.2e} |"
         )
     return lines
 
