@@ -106,11 +106,25 @@ def _through_stream(scene, how, reference: bool):
     if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
         note("tail: quasi-static (the stream solver: contact points are not known in advance)")
     band = stream_band(scene) if scene.plate_model == "modal" else None
+    if band and band["truncation_force_error"] > band["accuracy"]:
+        note(_band_warning(band))
     plate = _stream_plate(scene, band) if band and band["two_way"] else None
     result = _stream(scene, how, plate, reference)
     if band:
         _modal_sensors(scene, result, band, plate)
     return result
+
+
+def _band_warning(band) -> str:
+    """One line: the stream's band is below what its shortest plate contact needs."""
+    return (
+        f"modal band 0-{band['fmax_hz'] / 1e3:g} kHz ({band['reason']}): the shortest plate "
+        f"contacts ({band['hardest_contact']}, {band['contact_duration_min_s'] * 1e6:.0f} us) "
+        "would need "
+        f"{band['fmax_contact_hz'] / 1e3:.1f} kHz for a {band['accuracy']:.1%} peak force; "
+        f"estimated error up to {band['truncation_force_error']:.1%} (an upper estimate: "
+        "measured 0.04-0.85 of it; docs/streams.md, band and particle size)"
+    )
 
 
 def _rigid(scene, how):
@@ -170,15 +184,18 @@ def stream_band(scene) -> dict:
     STREAM_MIN_BAND_HZ), and the coupling (plate.coupling: two-way by default)."""
     from tailbeam.scene import ModalPlateSettings
     from tailbeam.signals.sensor import resolve
+    from tailbeam.solvers.coupled.auto import BAND_ACCURACY, stream_band_estimate
 
     settings = scene.modal or ModalPlateSettings()
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
     fmax = settings.fmax_hz or max(f_sensor, STREAM_MIN_BAND_HZ)
     two_way = settings.coupling == "two-way"
+    estimate = stream_band_estimate(scene, fmax, settings.residual_flexibility)
     return {
         "fmax_hz": float(fmax), "user_fmax": settings.fmax_hz is not None,
         "reason": "plate.fmax" if settings.fmax_hz else "the sensors' bandwidth",
-        "sensor_band_covered": bool(fmax >= f_sensor), "truncation_force_error": 0.0,
+        "sensor_band_covered": bool(fmax >= f_sensor),
+        "accuracy": BAND_ACCURACY, "truncation_force_error": 0.0, **estimate,
         "two_way": two_way,
         "coupling": (
             "two-way (the modes in the stream solver's active set; residual flexibility at "

@@ -141,3 +141,67 @@ def test_describe_choices_is_one_line(tmp_path, monkeypatch):
     assert "\n" not in line
     assert line.startswith("band 0-3.0 kHz (plate.fmax set in the scene)")
     assert f"{res.basis.n_modes} modes" in line and "8 divisions" in line
+
+
+STREAM = """
+duration = 0.5
+[plate]
+model = "modal"
+boundary = "SSSS"
+inclination = {incl}
+fmax = 10000.0
+[[streams]]
+name = "s"
+rate = 100.0
+start = 0.0
+stop = 0.4
+gangue_fraction = 0.5
+radius = [0.01, 0.04]
+area = [[-0.2, 0.2], [-0.2, 0.2]]
+height = [0.3, 0.8]
+seed = 3
+"""
+
+
+def _normal_impact(scene, particle):
+    """(normal speed m/s, Hertz contact duration s) of a particle's hardest plate impact."""
+    g_n = scene.gravity * np.cos(np.radians(scene.inclination))
+    law = scene.contacts().law(particle.name, "plate")
+    v = float(
+        np.sqrt(particle.velocity[2] ** 2 + 2 * g_n * (particle.position[2] - particle.radius))
+    )
+    return v, hertz_contact_duration(particle.mass, v, law.stiffness, law.exponent)
+
+
+def _ball_at_plate(particle, speed) -> str:
+    """The particle as a [[balls]] ball 1 nm above the plate, falling at ``speed`` m/s."""
+    r = float(particle.radius)
+    return (
+        f'[[balls]]\nname = "b"\nmaterial = "{particle.material.name}"\nradius = {r!r}\n'
+        f"position = [0.0, 0.0, {r + 1e-9!r}]\nvelocity = [0.0, 0.0, {-speed!r}]\n"
+    )
+
+
+def test_stream_band_estimates_the_shortest_contact_as_a_single_ball_would():
+    """A stream's band carries the same estimate as choose_band's for the particle with the
+    shortest contact (not a placeholder), and the run says when the band is too low."""
+    from tailbeam.simulation import _band_warning, stream_band
+
+    head = SCENE.split("[[balls]]")[0].format(plate="fmax = 10000.0")
+    for incl in (0.0, 30.0):
+        sc = loads_scene(STREAM.format(incl=incl))
+        band = stream_band(sc)
+        # the hardest contact is the shortest Hertz contact over every particle
+        shortest = min(sc.particles, key=lambda p: _normal_impact(sc, p)[1])
+        assert band["contact_duration_min_s"] == pytest.approx(
+            _normal_impact(sc, shortest)[1], rel=1e-12
+        )
+        # the same particle as a [[balls]] ball on a horizontal plate: choose_band's estimate
+        # (same pulse, same estimator); rel 1e-7: its 1 nm gap adds 2 g 1e-9 to v^2
+        p = next(q for q in sc.particles if q.name == band["hardest_contact"])
+        single = auto.choose_band(loads_scene(head + _ball_at_plate(p, _normal_impact(sc, p)[0])))
+        for key in ("truncation_force_error", "fmax_contact_hz"):
+            assert band[key] == pytest.approx(single[key], rel=1e-7)
+        assert band["truncation_force_error"] > auto.BAND_ACCURACY  # 10 mm lumps at 10 kHz
+    line = _band_warning(band)
+    assert "\n" not in line and "would need" in line and band["hardest_contact"] in line

@@ -75,6 +75,37 @@ def _contacts(scene: Scene, gravity: float = STANDARD_GRAVITY) -> dict:
     return out
 
 
+def stream_band_estimate(scene: Scene, fmax: float, residual: bool = True) -> dict:
+    """The band's estimated peak-force error for a stream scene's plate contacts, as
+    ``choose_band`` estimates a single ball's: per material, the particle with the shortest
+    Hertz contact at the largest normal speed it can reach (sqrt(vz^2 + 2 g cos(theta) gap),
+    plate frame), its force pulse, ``force_error_estimate`` at ``fmax`` (Hz) and the band
+    ``contact_band`` would need. Keys: truncation_force_error, hardest_contact,
+    contact_duration_min_s, fmax_contact_hz ({} without particles)."""
+    table, g_n = scene.contacts(), scene.gravity * math.cos(math.radians(scene.inclination))
+    shortest = {}  # material -> (duration, particle, speed, law)
+    for p in scene.particles:
+        law = table.law(p.name, "plate")
+        gap = p.position[2] - p.radius
+        speed = max(math.sqrt(p.velocity[2] ** 2 + 2.0 * g_n * max(gap, 0.0)), 1e-3)
+        duration = hertz_contact_duration(p.mass, speed, law.stiffness, law.exponent)
+        if p.material.name not in shortest or duration < shortest[p.material.name][0]:
+            shortest[p.material.name] = (duration, p, speed, law)
+    if not shortest:
+        return {}
+    pulses = {p.name: impact_pulse(p.mass, v, law) for _t, p, v, law in shortest.values()}
+    errors = {n: force_error_estimate(scene.plate, fmax, c, residual) for n, c in pulses.items()}
+    hardest = max(errors, key=errors.get)
+    return {
+        "truncation_force_error": float(errors[hardest]),
+        "hardest_contact": hardest,
+        "contact_duration_min_s": float(min(t for t, *_ in shortest.values())),
+        "fmax_contact_hz": float(
+            max(contact_band(scene.plate, c, residual=residual) for c in pulses.values())
+        ),
+    }
+
+
 def impact_pulse(mass: float, speed: float, law) -> dict:
     """Force pulse of a ball of ``mass`` (kg) striking a rigid flat at ``speed`` (m/s) under
     the IMPACT ``law``, without gravity: duration_s (s), compliance_m_n = penetration / force
