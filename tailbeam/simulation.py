@@ -100,14 +100,17 @@ def choose_solver(scene, solver: str = "auto", field: str = "solver") -> str:
 
 def _through_stream(scene, how, reference: bool):
     """``scene`` through the fast stream solver (or its reference), then its sensors."""
+    from tailbeam.solvers.coupled.auto import stream_band_estimate
     from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene
 
     check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
     if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
         note("tail: quasi-static (the stream solver: contact points are not known in advance)")
     band = stream_band(scene) if scene.plate_model == "modal" else None
-    if band and band["truncation_force_error"] > band["accuracy"]:
-        note(_band_warning(band))
+    if band:  # (the band check: here, not in stream_band, which sweeps call per case)
+        band.update(stream_band_estimate(scene, band["fmax_hz"], band["residual_flexibility"]))
+        if band["truncation_force_error"] > band["accuracy"]:
+            note(_band_warning(band))
     plate = _stream_plate(scene, band) if band and band["two_way"] else None
     result = _stream(scene, how, plate, reference)
     if band:
@@ -184,18 +187,17 @@ def stream_band(scene) -> dict:
     STREAM_MIN_BAND_HZ), and the coupling (plate.coupling: two-way by default)."""
     from tailbeam.scene import ModalPlateSettings
     from tailbeam.signals.sensor import resolve
-    from tailbeam.solvers.coupled.auto import BAND_ACCURACY, stream_band_estimate
+    from tailbeam.solvers.coupled.auto import BAND_ACCURACY
 
     settings = scene.modal or ModalPlateSettings()
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
     fmax = settings.fmax_hz or max(f_sensor, STREAM_MIN_BAND_HZ)
     two_way = settings.coupling == "two-way"
-    estimate = stream_band_estimate(scene, fmax, settings.residual_flexibility)
     return {
         "fmax_hz": float(fmax), "user_fmax": settings.fmax_hz is not None,
         "reason": "plate.fmax" if settings.fmax_hz else "the sensors' bandwidth",
         "sensor_band_covered": bool(fmax >= f_sensor),
-        "accuracy": BAND_ACCURACY, "truncation_force_error": 0.0, **estimate,
+        "accuracy": BAND_ACCURACY, "residual_flexibility": settings.residual_flexibility,
         "two_way": two_way,
         "coupling": (
             "two-way (the modes in the stream solver's active set; residual flexibility at "
