@@ -182,3 +182,27 @@ def test_local_sweep_through_the_in_process_client_matches_the_tcp_one(tmp_path,
         ds = xr.open_zarr(tmp_path / name / "dataset.zarr").load()
         sets[name] = ds.sortby("case_hash").drop_vars("case")
     xr.testing.assert_identical(sets["inproc"], sets["tcp"])
+
+
+def test_pause_sleeps_while_many_cases_are_left_and_waits_for_the_last_ones(monkeypatch):
+    """Between gathers the client sleeps GATHER_INTERVAL_S while the cases left take longer
+    than two intervals at the rate so far; near the end it waits on the cases left, at most
+    GATHER_INTERVAL_S (a timeout is not an error), so no sleep outlasts the last case."""
+    import dask.distributed
+
+    from tailbeam.study import sweep
+
+    calls = []
+    monkeypatch.setattr(sweep.time, "sleep", lambda s: calls.append(("sleep", s)))
+
+    def wait(futures, timeout):
+        calls.append(("wait", len(futures), timeout))
+        raise TimeoutError
+
+    monkeypatch.setattr(dask.distributed, "wait", wait)
+    interval = sweep.GATHER_INTERVAL_S
+    rate = 10.0  # cases/s: 2 intervals hold 2 * interval * rate cases
+    n_edge = int(2 * interval * rate)
+    sweep._pause(dict.fromkeys(range(n_edge + 1)), rate)
+    sweep._pause(dict.fromkeys(range(n_edge)), rate)
+    assert calls == [("sleep", interval), ("wait", n_edge, interval)]
