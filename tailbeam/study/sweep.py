@@ -11,8 +11,8 @@ Finished cases are gathered in batches (one request per batch of results, at mos
 ``GATHER_INTERVAL_S``, not one per case) and written in large batches (``DatasetStore.record``):
 a batch is written after ``FLUSH_SECONDS``, or once it holds ``FLUSH_BYTES`` of signals or
 ``FLUSH_CASES`` cases, so the client holds a bounded amount of results and a crash loses at most
-one batch. Running the same sweep again
-skips the cases already stored and retries the failed ones.
+one batch. Running the same sweep again skips the cases already stored and retries the failed
+ones.
 """
 
 import asyncio
@@ -32,8 +32,8 @@ FLUSH_BYTES = 64 << 20  # ... or once its signals take this many bytes ...
 FLUSH_CASES = 5000  # ... or once it holds this many cases, whichever comes first
 # collect finished results at most this often (s): each collection is a round trip client ->
 # scheduler -> workers and back on the client process's event loop, which shares the cores with
-# the workers (0.1 s: ~1-2 results per collection at ~20 cases/s). Near the end of a sweep the
-# client waits only until the last cases are done (_pause).
+# the workers (every 0.1 s, a collection held ~1-2 results at 10-20 cases/s). Near the end of
+# a sweep the client waits only until the last cases are done (_pause).
 GATHER_INTERVAL_S = 0.5
 # worker processes of a local cluster: Dask's defaults minus two costs that weigh on cases of a
 # few tens of ms: MALLOC_TRIM_THRESHOLD_=65536 (setting it turns off glibc's dynamic mmap
@@ -126,8 +126,8 @@ def connect(workers: int | None = None, scheduler: str | None = None):
 def in_process_client(cluster):
     """A Client of a local_cluster on the scheduler's event loop, through its ``inproc://``
     listener: messages between client and scheduler (task reports, gathers, releases) pass
-    as Python objects, without TCP or serialisation (~0.3-0.5 ms less of the client process's
-    CPU per task, measured on 200 short tasks)."""
+    as Python objects, without TCP or serialisation (the client process's CPU per task:
+    2.4-3.1 ms through TCP, 2.2 ms in-process, measured on 200 tasks of 50 ms)."""
     from dask.distributed import Client
 
     address = next(
