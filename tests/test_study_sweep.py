@@ -157,3 +157,52 @@ def test_a_case_prints_nothing_and_restores_progress(capsys):
     assert out["status"] == "ok", out["error"]
     assert capsys.readouterr().err == ""
     assert not is_quiet()
+
+
+def test_local_sweep_through_the_in_process_client_matches_the_tcp_one(tmp_path, scheduler, capsys):
+    """`--workers 1` starts a local cluster whose client talks to the scheduler in-process
+    (inproc://, no TCP); its dataset equals the one the same cases give through TCP
+    (``--scheduler``), signal for signal, and the pause before the last gather ends with
+    the last case (the sweep's batches hold every case)."""
+    from tailbeam.study.sweep import close_client, connect
+
+    client = connect(workers=1)
+    try:
+        assert client.scheduler.address.startswith("inproc://")
+        assert client.run(os.getpid).keys()  # its worker answers through the same link
+    finally:
+        close_client(client)
+    (tmp_path / "base.toml").write_text(BASE)
+    (tmp_path / "sweep.toml").write_text(SWEEP.format(fmax="3000.0, 2500.0"))
+    sets = {}
+    for name, extra in (("inproc", ["--workers", "1"]), ("tcp", ["--scheduler", scheduler])):
+        args = ["sweep", str(tmp_path / "sweep.toml"), "--out", str(tmp_path / name), *extra]
+        assert main(args) == 0
+        assert "4 cases, 0 already done, 4 run (4 ok, 0 failed)" in capsys.readouterr().out
+        ds = xr.open_zarr(tmp_path / name / "dataset.zarr").load()
+        sets[name] = ds.sortby("case_hash").drop_vars("case")
+    xr.testing.assert_identical(sets["inproc"], sets["tcp"])
+
+
+def test_pause_sleeps_while_many_cases_are_left_and_waits_for_the_last_ones(monkeypatch):
+    """Between gathers the client sleeps GATHER_INTERVAL_S while the cases left take longer
+    than two intervals at the rate so far; near the end it waits on the cases left, at most
+    GATHER_INTERVAL_S (a timeout is not an error), so no sleep outlasts the last case."""
+    import dask.distributed
+
+    from tailbeam.study import sweep
+
+    calls = []
+    monkeypatch.setattr(sweep.time, "sleep", lambda s: calls.append(("sleep", s)))
+
+    def wait(futures, timeout):
+        calls.append(("wait", len(futures), timeout))
+        raise TimeoutError
+
+    monkeypatch.setattr(dask.distributed, "wait", wait)
+    interval = sweep.GATHER_INTERVAL_S
+    rate = 10.0  # cases/s: 2 intervals hold 2 * interval * rate cases
+    n_edge = int(2 * interval * rate)
+    sweep._pause(dict.fromkeys(range(n_edge + 1)), rate)
+    sweep._pause(dict.fromkeys(range(n_edge)), rate)
+    assert calls == [("sleep", interval), ("wait", n_edge, interval)]
