@@ -26,6 +26,12 @@ within its dead band of the crossing. Kinks (full damping d crossed, clamp on/of
 applied inside (logged) and integration goes on in the new region; contact start / end,
 leave, settle return to the caller. Events within ``SAME_TIME`` of a step of a pending one
 are taken after it, one after the other at the same time (a symmetric 3-ball cluster).
+A row whose event was just applied sits on 0 at the restart ("fresh": searched from
+``cheb_events.FRESH_S`` on in the next step); the fresh rows are handed back on return and
+carried into the next call that starts at that instant (``active_set.ActiveSet.advance``;
+the stream driver carries them into a set rebuilt then, ``active_members``), so a START or
+END returned to the caller is never found again at the same instant (the grazing stall of
+issue 7), while a genuine new crossing later in the step still is.
 """
 
 import math
@@ -71,8 +77,9 @@ STATUS_NAMES = (
 # kinds in the event log
 LOG_FULL, LOG_CLAMP_ON, LOG_CLAMP_OFF = range(3)
 LOG_NAMES = (EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF)
-# integer outputs (iout)
-IO_STATUS, IO_INDEX, IO_EDGE, IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_ROWS, IO_LOG = range(8)
+# integer outputs (iout); IO_FRESH: the rows in ``fresh`` (in/out, see ``advance``)
+IO_STATUS, IO_INDEX, IO_EDGE, IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_ROWS, IO_LOG, IO_FRESH = range(9)
+IO_SIZE = 9
 
 SAME_TIME = 1e-9  # fraction of a step: events closer than this to a pending one wait for it
 MAX_FRESH = 16
@@ -321,7 +328,7 @@ def _take_step(t, h, y, ynew, f0, K, dense, nodes, pts, vinv, model, pstate, row
 @njit(cache=True)
 def _workspaces(y, model, pts):
     """Scratch arrays of one ``advance`` call: (K (16, N) stages, ynew (N,), tmp (N,), dense,
-    ws, count (n,), plate_pair (n,), fresh (MAX_FRESH, 2)) with dense = (Y15, have, coef,
+    ws, count (n,), plate_pair (n,)) with dense = (Y15, have, coef,
     y0, B, W15, have_w, proj) the step's dense output at the 15 points (``prepare``) and ws =
     (vals, wc, wv, wc2, wd, stack, tmp) the event search's (``detect``)."""
     nst = y.shape[0]
@@ -335,17 +342,16 @@ def _workspaces(y, model, pts):
           np.zeros((256, 3)), np.zeros(nst))  # fmt: skip
     count = np.zeros(nb, dtype=np.int64)
     plate_pair = np.zeros(nb, dtype=np.int64)
-    fresh = np.zeros((MAX_FRESH, 2), dtype=np.int64)
-    return np.zeros((16, nst)), np.zeros(nst), np.zeros(nst), dense, ws, count, plate_pair, fresh
+    return np.zeros((16, nst)), np.zeros(nst), np.zeros(nst), dense, ws, count, plate_pair
 
 
 @helper_njit
 def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pts, vinv,
-         rows, log, iout, work):  # fmt: skip
-    """The stepping loop of ``advance`` from t (s) with first step h (s) and f0 = f(y) (work:
-    ``_workspaces``): returns (status, t, next step h, attempts)."""
-    K, ynew, tmp, dense, ws, count, plate_pair, fresh = work
-    nfresh = np.int64(0)  # (typed int64, not a literal: one compiled signature per helper)
+         rows, log, iout, work, fresh, nfresh):  # fmt: skip
+    """The stepping loop of ``advance`` from t (s) with first step h (s), f0 = f(y) (work:
+    ``_workspaces``) and the rows fresh[:nfresh] applied at t: returns (status, t, next
+    step h, attempts, nfresh: the rows of fresh applied at the returned t)."""
+    K, ynew, tmp, dense, ws, count, plate_pair = work
     pend_k, pend_i, pend_t = np.int64(-1), np.int64(-1), 0.0  # the pending event
     rejected = False
     attempts = 0
@@ -353,23 +359,23 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
         t_bound = pend_t if pend_k >= 0 else t_stop
         if t >= t_bound:
             if pend_k < 0:
-                return ST_STOP, t, h, attempts
+                return ST_STOP, t, h, attempts, nfresh
             status, nfresh = _apply_pending(pend_k, pend_i, t, y, model, pstate, rows, log, iout,
                                             fresh, nfresh, f0)  # fmt: skip
             pend_k = np.int64(-1)
             if status >= 0:
-                return status, t, h, attempts
+                return status, t, h, attempts, nfresh
             continue
         status = _limits(attempts, max_steps, nodes, model, pstate, rows, log, iout)
         if status >= 0:
-            return status, t, h, attempts
+            return status, t, h, attempts, nfresh
         last = h >= t_bound - t
         hh = t_bound - t if last else h
         if hh <= 4.0 * EPS * abs(t):
             if last:  # the bound is within round-off of t: snap to it
                 t = t_bound
                 continue
-            return ST_STEP_TINY, t, h, attempts
+            return ST_STEP_TINY, t, h, attempts, nfresh
         attempts += 1
         err = _attempt(y, hh, K, f0, tab, rtol, atol, model, pstate, ynew, tmp, iout)
         if not err <= 1.0:
@@ -390,14 +396,14 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
             h = hh * factor
             if b >= 0:
                 iout[IO_INDEX] = b
-                return ST_SETTLE, t, h, attempts
+                return ST_SETTLE, t, h, attempts, nfresh
             continue
         t_e = t + s * hh
         if t_e <= t + 4.0 * EPS * abs(t) or s == 0.0:  # at the restart: apply there
             status, nfresh = _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh,
                                          nfresh, f0)  # fmt: skip
             if status >= 0:
-                return status, t, h, attempts
+                return status, t, h, attempts, nfresh
             continue
         pend_k, pend_i, pend_t = k, i, t_e  # redo the step to end exactly at the event
         h = t_e - t
@@ -405,7 +411,7 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
 
 @njit(cache=True)
 def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pts, vinv, rows,
-            log, iout):  # fmt: skip
+            log, iout, fresh):  # fmt: skip
     """Advance the active set from tio[0] with first step tio[1] until an event or t_stop.
 
     y (6 n + 2 m,) state in/out (m modes); atol (6 n + 2 m,) absolute tolerance per component.
@@ -415,14 +421,24 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
     tab = DOP853 (A, B, E3, E5, D). rows (R, 3) force rows (t, pair, F) and log (L, 3) kinks
     (t, kind, pair) are appended from iout[IO_ROWS], iout[IO_LOG]. On return: tio = [t, next
     step], iout[IO_STATUS] (ST_*), iout[IO_INDEX] (pair or ball), iout[IO_EDGE], work counts.
+
+    fresh (MAX_FRESH, 2) rows (kind, index) whose events were applied at tio[0], in/out: the
+    first iout[IO_FRESH] on entry (the caller passes those of the previous return when it
+    restarts at that time, else none) and on return those applied at the returned time
+    since the last accepted step. Their functions sit on 0 at the restart: the first step
+    searches them from ``cheb_events.FRESH_S`` on, so an event just applied is not found
+    again at the same instant, while a genuine new crossing later in the step still is.
     """
     work = _workspaces(y, model, pts)
     K = work[0]
     rhs(y, model, pstate, K[0])
     iout[IO_NFEV] += 1
     f0 = K[0].copy()
-    status, t, h, attempts = _run(tio[0], tio[1], f0, y, t_stop, rtol, atol, max_steps, nodes,
-                                  model, pstate, tab, pts, vinv, rows, log, iout, work)  # fmt: skip
+    nfresh = np.int64(min(max(iout[IO_FRESH], 0), MAX_FRESH))
+    status, t, h, attempts, nfresh = _run(tio[0], tio[1], f0, y, t_stop, rtol, atol, max_steps,
+                                          nodes, model, pstate, tab, pts, vinv, rows, log, iout,
+                                          work, fresh, nfresh)  # fmt: skip
+    iout[IO_FRESH] = nfresh
     if status == ST_START:
         h = min(h, first_contact_step(y, model, iout[IO_INDEX], rtol))
     tio[0] = t
