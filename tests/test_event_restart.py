@@ -56,10 +56,12 @@ def test_an_event_just_applied_is_not_found_again_at_that_instant():
     assert -(s.penetration(0)[0]) > 0.0  # (the balls are apart: the row's value checks)
     out = s.advance(T0, T0 + 1e-3, h=1e-6)
     assert (out.kind, out.t) == ("contact_end", T0)
+    assert s.stats["found_again"] == 0
 
     s = _pair_on_its_end_crossing(fresh=True)
     out = s.advance(T0, T0 + 1e-3, h=1e-6)
     assert out.kind == "contact_end" and T0 < out.t <= T0 + 1e-6
+    assert s.stats["found_again"] == 1  # (found at T0, searched again: at the next step)
 
 
 def test_markers_of_another_instant_are_not_carried():

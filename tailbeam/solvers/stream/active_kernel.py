@@ -42,7 +42,7 @@ from numba import njit
 from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.records import EventKind
 from tailbeam.solvers.rigid.dop853 import growth, shrink
-from tailbeam.solvers.stream.active_events import detect, prepare
+from tailbeam.solvers.stream.active_events import detect, is_fresh, prepare
 from tailbeam.solvers.stream.active_pairs import (
     R_CONTACT,
     R_EDGE,
@@ -77,9 +77,11 @@ STATUS_NAMES = (
 # kinds in the event log
 LOG_FULL, LOG_CLAMP_ON, LOG_CLAMP_OFF = range(3)
 LOG_NAMES = (EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF)
-# integer outputs (iout); IO_FRESH: the rows in ``fresh`` (in/out, see ``advance``)
-IO_STATUS, IO_INDEX, IO_EDGE, IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_ROWS, IO_LOG, IO_FRESH = range(9)
-IO_SIZE = 9
+# integer outputs (iout); IO_FRESH: the rows in ``fresh`` (in/out, see ``advance``);
+# IO_AGAIN: events found again at the instant they were applied (searched again; counted)
+IO_STATUS, IO_INDEX, IO_EDGE, IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_ROWS, IO_LOG = range(8)
+IO_FRESH, IO_AGAIN = 8, 9
+IO_SIZE = 10
 
 SAME_TIME = 1e-9  # fraction of a step: events closer than this to a pending one wait for it
 MAX_FRESH = 16
@@ -213,14 +215,42 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
 
 
 @helper_njit
+def _mark(k, i, fresh, nfresh):
+    """Remember row (k, i) as fresh (up to MAX_FRESH rows); returns the new count."""
+    if nfresh < MAX_FRESH:
+        fresh[nfresh, 0], fresh[nfresh, 1] = k, i
+        nfresh += 1
+    return nfresh
+
+
+@helper_njit
+def _found_again(k, i, s, h, t, t0, carried, ncarried, fresh, nfresh):
+    """Whether the crossing of row (k, i) at fraction s of the step of h (s) from t (s) is the
+    event the previous call applied and returned at t0 = t (``carried``): at the restart
+    instant (where it would be applied there), and not yet marked fresh in this call."""
+    if ncarried == 0 or t != t0 or not (t + s * h <= t + 4.0 * EPS * abs(t) or s == 0.0):
+        return False
+    return is_fresh(k, i, carried, ncarried) and not is_fresh(k, i, fresh, nfresh)
+
+
+@helper_njit
+def _hand_back(carried, ncarried, fresh, nfresh, same_instant):
+    """The rows applied at the instant ``advance`` returns at, into ``carried``: this call's
+    fresh rows, and those carried in when time did not move. Returns their count."""
+    n = ncarried if same_instant else 0
+    for q in range(nfresh):
+        if not is_fresh(fresh[q, 0], fresh[q, 1], carried, n):
+            n = _mark(fresh[q, 0], fresh[q, 1], carried, n)
+    return n
+
+
+@helper_njit
 def _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
     """Apply the event of row (k, i) at (t, y), remember the row as fresh (its function sits
     on 0 at the restart) and, after a kink handled here, recompute f0 = f(y) in the new
     region. Returns (status or -1, nfresh)."""
     status = _apply(k, i, t, y, model, pstate, rows, log, iout)
-    if nfresh < MAX_FRESH:
-        fresh[nfresh, 0], fresh[nfresh, 1] = k, i
-        nfresh += 1
+    nfresh = _mark(k, i, fresh, nfresh)
     if status < 0:
         rhs(y, model, pstate, f0)
         iout[IO_NFEV] += 1
@@ -328,7 +358,7 @@ def _take_step(t, h, y, ynew, f0, K, dense, nodes, pts, vinv, model, pstate, row
 @njit(cache=True)
 def _workspaces(y, model, pts):
     """Scratch arrays of one ``advance`` call: (K (16, N) stages, ynew (N,), tmp (N,), dense,
-    ws, count (n,), plate_pair (n,)) with dense = (Y15, have, coef,
+    ws, count (n,), plate_pair (n,), fresh (MAX_FRESH, 2)) with dense = (Y15, have, coef,
     y0, B, W15, have_w, proj) the step's dense output at the 15 points (``prepare``) and ws =
     (vals, wc, wv, wc2, wd, stack, tmp) the event search's (``detect``)."""
     nst = y.shape[0]
@@ -342,16 +372,19 @@ def _workspaces(y, model, pts):
           np.zeros((256, 3)), np.zeros(nst))  # fmt: skip
     count = np.zeros(nb, dtype=np.int64)
     plate_pair = np.zeros(nb, dtype=np.int64)
-    return np.zeros((16, nst)), np.zeros(nst), np.zeros(nst), dense, ws, count, plate_pair
+    fresh = np.zeros((MAX_FRESH, 2), dtype=np.int64)
+    return np.zeros((16, nst)), np.zeros(nst), np.zeros(nst), dense, ws, count, plate_pair, fresh
 
 
 @helper_njit
 def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pts, vinv,
-         rows, log, iout, work, fresh, nfresh):  # fmt: skip
+         rows, log, iout, work, carried, ncarried):  # fmt: skip
     """The stepping loop of ``advance`` from t (s) with first step h (s), f0 = f(y) (work:
-    ``_workspaces``) and the rows fresh[:nfresh] applied at t: returns (status, t, next
-    step h, attempts, nfresh: the rows of fresh applied at the returned t)."""
-    K, ynew, tmp, dense, ws, count, plate_pair = work
+    ``_workspaces``) and carried[:ncarried] the rows the previous call applied at t: returns
+    (status, t, next step h, attempts, nfresh: the rows in work's fresh applied at that t)."""
+    K, ynew, tmp, dense, ws, count, plate_pair, fresh = work
+    nfresh = np.int64(0)  # (typed int64, not a literal: one compiled signature per helper)
+    t0 = t
     pend_k, pend_i, pend_t = np.int64(-1), np.int64(-1), 0.0  # the pending event
     rejected = False
     attempts = 0
@@ -386,6 +419,10 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
                                vinv, ws, iout, tmp)  # fmt: skip
         if k >= 0 and pend_k >= 0 and t + s * hh >= pend_t - SAME_TIME * hh:
             k = -1  # (about) simultaneous with the pending event: taken after it
+        if k >= 0 and _found_again(k, i, s, hh, t, t0, carried, ncarried, fresh, nfresh):
+            nfresh = _mark(k, i, fresh, nfresh)  # (its event was just applied: search again)
+            iout[IO_AGAIN] += 1
+            continue
         factor = growth(err, rejected)
         rejected = False
         if k < 0:
@@ -425,20 +462,22 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
     fresh (MAX_FRESH, 2) rows (kind, index) whose events were applied at tio[0], in/out: the
     first iout[IO_FRESH] on entry (the caller passes those of the previous return when it
     restarts at that time, else none) and on return those applied at the returned time
-    since the last accepted step. Their functions sit on 0 at the restart: the first step
-    searches them from ``cheb_events.FRESH_S`` on, so an event just applied is not found
-    again at the same instant, while a genuine new crossing later in the step still is.
+    (with those carried in if time did not move). Their functions sit on 0 at the restart:
+    a crossing of one of them found at the restart instant (where it would be applied
+    there: the same event again) makes it fresh for this call and the step is searched
+    again, from ``cheb_events.FRESH_S`` on for that row, so a genuine new crossing later in
+    the step is still found. Any other search is exactly as without the markers.
     """
     work = _workspaces(y, model, pts)
     K = work[0]
     rhs(y, model, pstate, K[0])
     iout[IO_NFEV] += 1
     f0 = K[0].copy()
-    nfresh = np.int64(min(max(iout[IO_FRESH], 0), MAX_FRESH))
+    ncarried = np.int64(min(max(iout[IO_FRESH], 0), MAX_FRESH))
     status, t, h, attempts, nfresh = _run(tio[0], tio[1], f0, y, t_stop, rtol, atol, max_steps,
                                           nodes, model, pstate, tab, pts, vinv, rows, log, iout,
-                                          work, fresh, nfresh)  # fmt: skip
-    iout[IO_FRESH] = nfresh
+                                          work, fresh, ncarried)  # fmt: skip
+    iout[IO_FRESH] = _hand_back(fresh, ncarried, work[7], nfresh, t == tio[0])
     if status == ST_START:
         h = min(h, first_contact_step(y, model, iout[IO_INDEX], rtol))
     tio[0] = t

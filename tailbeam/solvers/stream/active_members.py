@@ -22,6 +22,7 @@ import numpy as np
 from tailbeam.physics.contact_patch import load_radius
 from tailbeam.physics.contacts import PLATE
 from tailbeam.physics.incline import EDGES
+from tailbeam.solvers.stream.active_kernel import IO_AGAIN
 from tailbeam.solvers.stream.active_pairs import (
     L_CRES,
     R_EDGE,
@@ -51,6 +52,7 @@ class ActiveMembers:
         self.h = 0.0
         self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
         self.totals = {"kernel_steps": 0, "kernel_attempts": 0, "kernel_nfev": 0, "rebuilds": 0}
+        self.totals["events_found_again"] = 0  # at the instant they were applied (issue 7)
         self._shape_cache = {}  # ball -> (xy, mode shapes there): modal plate
         self._phi_xy = {}  # plate pair key -> the point (x, y) of its mode shapes
         self._load_radii = {}  # ball -> radius (m) of its load model (contact_patch)
@@ -243,7 +245,9 @@ class ActiveMembers:
             self.totals["kernel_steps"] += st["steps"]
             self.totals["kernel_attempts"] += st["attempts"]
             self.totals["kernel_nfev"] += st["nfev"]
+            self.totals["events_found_again"] += st["found_again"]
             self.set.iout[3:6] = 0  # counted
+            self.set.iout[IO_AGAIN] = 0
 
     def _ready(self):
         if self.dirty:

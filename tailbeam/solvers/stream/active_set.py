@@ -56,6 +56,8 @@ from tailbeam.solvers.stream.cheb_events import tables as cheb_tables
 from tailbeam.solvers.stream.modal_block import ModalBlock
 
 DEFAULT_NODES = 40  # interior force rows per step: linear interpolation < 1e-5 of the peak
+CARRY_FRESH = True  # False: a restart forgets the events just applied (before issue 7's fix;
+# benchmarks/bench_event_restart.py compares both)
 
 
 @dataclass(frozen=True)
@@ -285,7 +287,7 @@ class ActiveSet:
         time the previous one returned at carries the rows whose events were applied then
         (``fresh_rows``): they are not found again at that instant."""
         tio = np.array([float(t0), float(h or self.h or 1e-5)])
-        if tio[0] != self.t_fresh:
+        if tio[0] != self.t_fresh or not CARRY_FRESH:
             self.iout[ak.IO_FRESH] = 0
         while True:
             self.iout[ak.IO_STATUS] = -1
@@ -339,9 +341,11 @@ class ActiveSet:
 
     @property
     def stats(self) -> dict:
-        """Accepted steps, attempted steps and right-hand-side evaluations so far."""
+        """Accepted steps, attempted steps, right-hand-side evaluations and events found
+        again at the instant they were applied (searched again: ``active_kernel.advance``)."""
         return {"steps": int(self.iout[ak.IO_STEPS]), "attempts": int(self.iout[ak.IO_ATTEMPTS]),
-                "nfev": int(self.iout[ak.IO_NFEV])}  # fmt: skip
+                "nfev": int(self.iout[ak.IO_NFEV]),
+                "found_again": int(self.iout[ak.IO_AGAIN])}  # fmt: skip
 
 
 def _with_compliance(laws, pj, compliance) -> np.ndarray:
