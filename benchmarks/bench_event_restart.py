@@ -1,7 +1,7 @@
 """The event restart across the active set's returns (issue 7): markers carried or forgotten.
 
     python benchmarks/bench_event_restart.py [--seeds A:B] [--duration S] [--no-residual]
-                                             [--out DIR]
+                                             [--rtol R] [--out DIR]
 
 Study 2's stream (examples/study_stream_gangue_fraction.py: 30 deg SSSS plate, modes to 5 kHz
 coupled both ways, 100 lumps/s, 10-40 mm, contact damping 300 N s/m) for each stream seed,
@@ -33,7 +33,7 @@ HERE = Path(__file__).resolve().parent
 EXAMPLES = HERE.parent / "examples"
 
 
-def run_case(seed: int, duration: float, residual: bool, carry: bool, events_path: str) -> dict:
+def run_case(seed, duration, residual, carry, events_path, rtol=1e-10) -> dict:
     """Child process: one stream run; its figures (JSON) and its events (to events_path)."""
     import time
 
@@ -50,7 +50,7 @@ def run_case(seed: int, duration: float, residual: bool, carry: bool, events_pat
     data["plate"]["residual_flexibility"] = residual
     data["sensors"] = []
     t0 = time.perf_counter()
-    result = tailbeam.simulate(parse_scene(data), progress=False)
+    result = tailbeam.simulate(parse_scene(data), rtol=rtol, progress=False)
     wall = time.perf_counter() - t0
     events = [(float(e.t), e.ball, str(e.kind), str(e.partner)) for e in result.events]
     Path(events_path).write_text(json.dumps(events))
@@ -93,11 +93,12 @@ def same_instant(events) -> int:
     return count
 
 
-def _child(out: Path, seed: int, duration: float, residual: bool, carry: bool) -> dict:
+def _child(out: Path, seed: int, duration: float, residual: bool, carry: bool, rtol) -> dict:
     path = out / f"events_{seed}_{'carry' if carry else 'forget'}.json"
     code = (
         f"import json, sys; sys.path.insert(0, {str(HERE)!r}); import bench_event_restart as b; "
-        f"print(json.dumps(b.run_case({seed}, {duration}, {residual}, {carry}, {str(path)!r})))"
+        f"print(json.dumps(b.run_case({seed}, {duration}, {residual}, {carry}, {str(path)!r}, "
+        f"{rtol!r})))"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     if done.returncode:
@@ -115,11 +116,11 @@ def first_difference(a: list, b: list):
     return None if len(a) == len(b) else min(len(a), len(b))
 
 
-def main(seeds, duration: float, residual: bool, out: Path):
+def main(seeds, duration: float, residual: bool, out: Path, rtol: float = 1e-10):
     out.mkdir(parents=True, exist_ok=True)
     jobs = [(s, c) for s in seeds for c in (False, True)]
     with ThreadPoolExecutor(2) as pool:  # two child processes at a time
-        done = pool.map(lambda j: _child(out, j[0], duration, residual, j[1]), jobs)
+        done = pool.map(lambda j: _child(out, j[0], duration, residual, j[1], rtol), jobs)
         res = dict(zip(jobs, done, strict=True))
     rows = []
     for seed in seeds:
@@ -144,7 +145,8 @@ if __name__ == "__main__":
     ap.add_argument("--seeds", default="1:9", help="stream seeds A:B (B excluded)")
     ap.add_argument("--duration", type=float, default=3.0, help="simulated time, s")
     ap.add_argument("--no-residual", action="store_true", help="plate.residual_flexibility off")
+    ap.add_argument("--rtol", type=float, default=1e-10, help="the stream solver's rtol")
     ap.add_argument("--out", default="out/bench_event_restart")
     args = ap.parse_args()
     a, b = (int(v) for v in args.seeds.split(":"))
-    main(range(a, b), args.duration, not args.no_residual, Path(args.out))
+    main(range(a, b), args.duration, not args.no_residual, Path(args.out), args.rtol)
