@@ -2,13 +2,13 @@
 
 An event the kernel applies leaves its row's function on 0 at that instant. Inside one
 ``advance`` call the row is searched from ``cheb_events.FRESH_S`` on in the next step (it is
-"fresh"); a START or END returns to the caller, and the next call from that instant must carry
-the marker too, else it finds the same crossing again at the same instant (a contact that
-starts and ends at one time, over and over: the stall the stream driver once retried at a
-tighter rtol). The markers must not hide a genuine new crossing: checked against the closed
-form of a free flight. The truths here: where the row sits (computed from the state), the
-closed-form flight under gravity, and the kernel's own result without the marker.
-"""
+"fresh"); a START or END returns to the caller, and the next call from that instant carries
+the marker: a carried row whose crossing is found at the restart instant while it is back on
+its side at FRESH_S is searched again (counted in ``stats["found_again"]``), so a crossing
+sitting on 0 is not applied again at once, while a row on its wrong side there (a genuine
+crossing, due now) and a genuine new crossing later are found as without the marker. The
+truths here: where the rows sit and when they cross (closed forms of uniform motion and of a
+free flight under gravity), and the kernel's own result without the marker"""
 
 import math
 
@@ -29,47 +29,60 @@ BAND = 1e-12 * (2 * R) ** 2  # the contact row's dead band of a ball-ball pair (
 T0 = 0.25  # s: the restart instant
 
 
-def _pair_on_its_end_crossing(fresh: bool) -> ActiveSet:
-    """Two touching balls (g = 0) separating at 1 mm/s whose contact row sits just past
-    its END crossing at T0: f = d^2 - (2R)^2 = 1.5 x band, the state right after a START
-    applied within the dead band (``active_kernel._apply_pending`` accepts up to 2 bands).
-    ``fresh``: the START of this row was applied at T0 (the marker the kernel returns)."""
-    d = math.sqrt((2 * R) ** 2 + 1.5 * BAND)
+def _touching_pair(f0: float, t0: float, fresh: bool) -> ActiveSet:
+    """Two touching balls (g = 0) separating at 2 cm/s with f = d^2 - (2R)^2 = f0 at t0
+    (the END row is band - f0); ``fresh``: its START was applied at t0 (the marker the
+    kernel returns)."""
+    d = math.sqrt((2 * R) ** 2 + f0)
     law = ball_ball_law(COAL, R, COAL, R)
     mass = Ball("a", COAL, R, (0, 0, 0)).mass
     s = ActiveSet(
-        [(0.0, 0.0, 0.1), (d, 0.0, 0.1)], [(-5e-4, 0.0, 0.0), (5e-4, 0.0, 0.0)],
+        [(0.0, 0.0, 0.1), (d, 0.0, 0.1)], [(-0.01, 0.0, 0.0), (0.01, 0.0, 0.0)],
         [mass, mass], [R, R], [(0, 1)], [law], (0.0, 0.0, 0.0), (0.3, 0.3), rtol=1e-10,
     )  # fmt: skip
     s.touching[0] = True
     if fresh:
-        s.set_fresh(T0, [(R_CONTACT, 0)])
+        s.set_fresh(t0, [(R_CONTACT, 0)])
     return s
 
 
-def test_an_event_just_applied_is_not_found_again_at_that_instant():
-    """The mechanism of the stall. Without the marker, the row on its wrong side at the
-    restart is applied there: END at T0 itself (a zero-length contact; after a START returned
-    at T0 that is the same crossing found twice). With the marker carried from the return
-    at T0, time moves on: the END comes at the next step's start, later than T0."""
-    s = _pair_on_its_end_crossing(fresh=False)
-    assert -(s.penetration(0)[0]) > 0.0  # (the balls are apart: the row's value checks)
-    out = s.advance(T0, T0 + 1e-3, h=1e-6)
+@pytest.mark.parametrize("fresh", [False, True])
+def test_a_row_past_its_crossing_at_the_restart_is_applied_there(fresh):
+    """f0 = 1.5 bands: the END row is on its wrong side at the restart and beyond (the pair
+    separates): a genuine crossing, applied at T0 with or without the marker (the markers
+    never delay an event that is due)."""
+    s = _touching_pair(1.5 * BAND, T0, fresh)
+    out = s.advance(T0, T0 + 1e-3, h=1e-4)
     assert (out.kind, out.t) == ("contact_end", T0)
     assert s.stats["found_again"] == 0
 
-    s = _pair_on_its_end_crossing(fresh=True)
-    out = s.advance(T0, T0 + 1e-3, h=1e-6)
-    assert out.kind == "contact_end" and T0 < out.t <= T0 + 1e-6
-    assert s.stats["found_again"] == 1  # (found at T0, searched again: at the next step)
+
+def test_a_carried_row_found_at_the_restart_is_searched_again():
+    """f0 = 0.5 band at t = 1000 s: the END row (0.5 band) reaches 0 after tau = 0.5 band /
+    (df/dt) = 5.0e-13 s (closed form), within the restart window 4 eps t = 8.9e-13 s, so
+    the search puts it at the restart. Without the marker it is applied there at once; with
+    the START's marker carried it is found again (counted), searched again from FRESH_S of
+    the step on (it is back on its side there), found at the same crossing, inside the
+    window: applied at the restart, the same event as without the marker."""
+    t0 = 1000.0
+    s = _touching_pair(0.5 * BAND, t0, fresh=False)
+    d = s.x[1, 0] - s.x[0, 0]
+    tau = (BAND - (d * d - (2 * R) ** 2)) / (2.0 * d * 0.02)
+    assert 4 * math.ulp(t0) < tau < 4.0 * np.finfo(float).eps * t0  # (the window)
+    out = s.advance(t0, t0 + 1e-3, h=1e-4)
+    assert (out.kind, out.t, s.stats["found_again"]) == ("contact_end", t0, 0)
+    s = _touching_pair(0.5 * BAND, t0, fresh=True)
+    out = s.advance(t0, t0 + 1e-3, h=1e-4)
+    assert (out.kind, out.t, s.stats["found_again"]) == ("contact_end", t0, 1)
 
 
 def test_markers_of_another_instant_are_not_carried():
     """Markers apply only to a restart at the instant they were applied at."""
-    s = _pair_on_its_end_crossing(fresh=False)
-    s.set_fresh(T0 - 1e-4, [(R_CONTACT, 0)])
-    out = s.advance(T0, T0 + 1e-3, h=1e-6)
-    assert (out.kind, out.t) == ("contact_end", T0)
+    t0 = 1000.0
+    s = _touching_pair(0.5 * BAND, t0, fresh=False)
+    s.set_fresh(t0 - 1e-4, [(R_CONTACT, 0)])
+    s.advance(t0, t0 + 1e-3, h=1e-4)
+    assert s.stats["found_again"] == 0
 
 
 @pytest.mark.parametrize("fresh", [False, True])
@@ -131,7 +144,7 @@ def test_set_fresh_keeps_at_most_the_kernel_capacity():
     """More markers than the kernel holds are cut to its capacity (MAX_FRESH), not an error."""
     from tailbeam.solvers.stream.active_kernel import MAX_FRESH
 
-    s = _pair_on_its_end_crossing(fresh=False)
+    s = _touching_pair(0.5 * BAND, T0, fresh=False)
     s.set_fresh(T0, [(R_CONTACT, 0)] * (MAX_FRESH + 3))
     assert len(s.fresh_rows()[1]) == MAX_FRESH
     assert np.all(s.fresh[:, 0] == R_CONTACT)

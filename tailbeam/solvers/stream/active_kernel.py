@@ -61,12 +61,13 @@ from tailbeam.solvers.stream.active_step import (
     dense_coef,
     dense_component,
     dense_projected,
+    dense_state,
     dop853_step,
     ensure_ball,
     ensure_plate,
     project_plate,
 )
-from tailbeam.solvers.stream.cheb_events import interpolant_max
+from tailbeam.solvers.stream.cheb_events import FRESH_S, interpolant_max
 
 # return status of ``advance``
 ST_STOP, ST_START, ST_END, ST_LEAVE, ST_SETTLE, ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = range(8)
@@ -224,13 +225,19 @@ def _mark(k, i, fresh, nfresh):
 
 
 @helper_njit
-def _found_again(k, i, s, h, t, t0, carried, ncarried, fresh, nfresh):
+def _found_again(k, i, s, h, t, t0, carried, ncarried, fresh, nfresh, dense, model, pstate,
+                 tmp):  # fmt: skip
     """Whether the crossing of row (k, i) at fraction s of the step of h (s) from t (s) is the
-    event the previous call applied and returned at t0 = t (``carried``): at the restart
-    instant (where it would be applied there), and not yet marked fresh in this call."""
+    event the previous call applied and returned at t0 = t (``carried``) found again: at
+    the restart instant (where it would be applied there), not yet marked fresh in this
+    call, and back on its side at ``FRESH_S`` of the step (it sat on 0; a row still on the
+    wrong side there crosses now, genuinely: applied at the restart as without markers)."""
     if ncarried == 0 or t != t0 or not (t + s * h <= t + 4.0 * EPS * abs(t) or s == 0.0):
         return False
-    return is_fresh(k, i, carried, ncarried) and not is_fresh(k, i, fresh, nfresh)
+    if not is_fresh(k, i, carried, ncarried) or is_fresh(k, i, fresh, nfresh):
+        return False
+    dense_state(dense[2], dense[3], FRESH_S, tmp)
+    return row_value(k, i, tmp, model, pstate) > 0.0
 
 
 @helper_njit
@@ -419,7 +426,8 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
                                vinv, ws, iout, tmp)  # fmt: skip
         if k >= 0 and pend_k >= 0 and t + s * hh >= pend_t - SAME_TIME * hh:
             k = -1  # (about) simultaneous with the pending event: taken after it
-        if k >= 0 and _found_again(k, i, s, hh, t, t0, carried, ncarried, fresh, nfresh):
+        if k >= 0 and _found_again(k, i, s, hh, t, t0, carried, ncarried, fresh, nfresh, dense,
+                                   model, pstate, tmp):  # fmt: skip
             nfresh = _mark(k, i, fresh, nfresh)  # (its event was just applied: search again)
             iout[IO_AGAIN] += 1
             continue
@@ -464,9 +472,11 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
     restarts at that time, else none) and on return those applied at the returned time
     (with those carried in if time did not move). Their functions sit on 0 at the restart:
     a crossing of one of them found at the restart instant (where it would be applied
-    there: the same event again) makes it fresh for this call and the step is searched
-    again, from ``cheb_events.FRESH_S`` on for that row, so a genuine new crossing later in
-    the step is still found. Any other search is exactly as without the markers.
+    there: the same event again) while the row is back on its side at ``FRESH_S`` of the
+    step makes it fresh for this call and the step is searched again, from ``FRESH_S`` on
+    for that row, so a genuine new crossing later in the step is still found; a row still
+    on the wrong side at ``FRESH_S`` crosses there genuinely and is applied at the restart.
+    Any other search is exactly as without the markers.
     """
     work = _workspaces(y, model, pts)
     K = work[0]
