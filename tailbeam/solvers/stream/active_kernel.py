@@ -29,9 +29,11 @@ are taken after it, one after the other at the same time (a symmetric 3-ball clu
 A row whose event was just applied sits on 0 at the restart ("fresh": searched from
 ``cheb_events.FRESH_S`` on in the next step); the fresh rows are handed back on return and
 carried into the next call that starts at that instant (``active_set.ActiveSet.advance``;
-the stream driver carries them into a set rebuilt then, ``active_members``), so a START or
-END returned to the caller is never found again at the same instant (the grazing stall of
-issue 7), while a genuine new crossing later in the step still is.
+the stream driver carries them into a set rebuilt then, ``active_members``). A carried row
+whose crossing is found at the restart instant while it is back on its side at FRESH_S is
+searched again as fresh (``_found_again``): a START or END returned to the caller is not
+applied again at once where its row sat on 0 (the grazing stall of issue 7); a row still on
+its wrong side there, and a genuine new crossing later in the step, are found as before.
 """
 
 import math

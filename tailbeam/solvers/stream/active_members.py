@@ -6,8 +6,8 @@ set is rebuilt on the next ``advance`` after a change, carrying over each pair's
 (touching, region flags, peak force, maximum penetration) by its key: (i, -1) for ball i on
 the plate, (i, j) with i < j for two balls. Every pair among the members is watched (sets are
 small: the balls near a contact). A set rebuilt at the instant of an event carries the rows
-whose events were applied then (``ActiveSet.fresh_rows``, by key), so it does not find the
-same event again at that instant.
+whose events were applied then (``ActiveSet.fresh_rows``, by key), so that it does not
+apply the same event again at once (``active_kernel.advance``).
 
 On the modal plate each plate pair also gets the residual compliance (m/N) of the truncated
 modes at the point of its mode shapes (``StreamPlate.compliance``, cached by point): when its

@@ -13,8 +13,9 @@ The fast stream solver's driver advances balls in free flight in closed form and
   distances are polynomials of degree <= 14 on a step, certified positive by their
   Chebyshev coefficients or searched for their first crossing (``cheb_events``), so a grazing
   approach and retreat inside one step is not missed;
-* an event returned at t is not found again by the next call from t: the rows applied at t
-  are carried into it (``fresh_rows``, ``set_fresh``; a genuine new crossing after t is);
+* the rows whose events were applied at the time t a call returns at are carried into the
+  next call from t (``fresh_rows``, ``set_fresh``): one found crossing again right at t
+  while back on its side just after is searched again (``active_kernel.advance``);
 * SETTLE is checked at accepted step ends only: a ball whose only touching pair is the plate
   and whose normal excess energy over the static state (``active_pairs.settle_excess``)
   falls below its settle energy;
@@ -285,7 +286,8 @@ class ActiveSet:
         docstring. h: first step (s; default: the step suggested by the previous call, or
         1e-5 s). Grows the force-row and log buffers as needed. A call that starts at the
         time the previous one returned at carries the rows whose events were applied then
-        (``fresh_rows``): they are not found again at that instant."""
+        (``fresh_rows``): one whose crossing sits on 0 there is not applied again at once
+        (``active_kernel.advance``)."""
         tio = np.array([float(t0), float(h or self.h or 1e-5)])
         if tio[0] != self.t_fresh or not CARRY_FRESH:
             self.iout[ak.IO_FRESH] = 0
