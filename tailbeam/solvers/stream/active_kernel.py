@@ -26,6 +26,14 @@ within its dead band of the crossing. Kinks (full damping d crossed, clamp on/of
 applied inside (logged) and integration goes on in the new region; contact start / end,
 leave, settle return to the caller. Events within ``SAME_TIME`` of a step of a pending one
 are taken after it, one after the other at the same time (a symmetric 3-ball cluster).
+A row whose event was just applied sits on 0 at the restart ("fresh": searched from
+``cheb_events.FRESH_S`` on in the next step); the fresh rows are handed back on return and
+carried into the next call that starts at that instant (``active_set.ActiveSet.advance``;
+the stream driver carries them into a set rebuilt then, ``active_members``). A carried row
+whose crossing is found at the restart instant while it is back on its side at FRESH_S is
+searched again as fresh (``_found_again``): a START or END returned to the caller is not
+applied again at once where its row sat on 0 (the grazing stall of issue 7); a row still on
+its wrong side there, and a genuine new crossing later in the step, are found as before.
 """
 
 import math
@@ -36,7 +44,7 @@ from numba import njit
 from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.records import EventKind
 from tailbeam.solvers.rigid.dop853 import growth, shrink
-from tailbeam.solvers.stream.active_events import detect, prepare
+from tailbeam.solvers.stream.active_events import detect, is_fresh, prepare
 from tailbeam.solvers.stream.active_pairs import (
     R_CONTACT,
     R_EDGE,
@@ -55,12 +63,13 @@ from tailbeam.solvers.stream.active_step import (
     dense_coef,
     dense_component,
     dense_projected,
+    dense_state,
     dop853_step,
     ensure_ball,
     ensure_plate,
     project_plate,
 )
-from tailbeam.solvers.stream.cheb_events import interpolant_max
+from tailbeam.solvers.stream.cheb_events import FRESH_S, interpolant_max
 
 # return status of ``advance``
 ST_STOP, ST_START, ST_END, ST_LEAVE, ST_SETTLE, ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = range(8)
@@ -71,8 +80,11 @@ STATUS_NAMES = (
 # kinds in the event log
 LOG_FULL, LOG_CLAMP_ON, LOG_CLAMP_OFF = range(3)
 LOG_NAMES = (EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF)
-# integer outputs (iout)
+# integer outputs (iout); IO_FRESH: the rows in ``fresh`` (in/out, see ``advance``);
+# IO_AGAIN: events found again at the instant they were applied (searched again; counted)
 IO_STATUS, IO_INDEX, IO_EDGE, IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_ROWS, IO_LOG = range(8)
+IO_FRESH, IO_AGAIN = 8, 9
+IO_SIZE = 10
 
 SAME_TIME = 1e-9  # fraction of a step: events closer than this to a pending one wait for it
 MAX_FRESH = 16
@@ -206,14 +218,48 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
 
 
 @helper_njit
+def _mark(k, i, fresh, nfresh):
+    """Remember row (k, i) as fresh (up to MAX_FRESH rows); returns the new count."""
+    if nfresh < MAX_FRESH:
+        fresh[nfresh, 0], fresh[nfresh, 1] = k, i
+        nfresh += 1
+    return nfresh
+
+
+@helper_njit
+def _found_again(k, i, s, h, t, t0, carried, ncarried, fresh, nfresh, dense, model, pstate,
+                 tmp):  # fmt: skip
+    """Whether the crossing of row (k, i) at fraction s of the step of h (s) from t (s) is the
+    event the previous call applied and returned at t0 = t (``carried``) found again: at
+    the restart instant (where it would be applied there), not yet marked fresh in this
+    call, and back on its side at ``FRESH_S`` of the step (it sat on 0; a row still on the
+    wrong side there crosses now, genuinely: applied at the restart as without markers)."""
+    if ncarried == 0 or t != t0 or not (t + s * h <= t + 4.0 * EPS * abs(t) or s == 0.0):
+        return False
+    if not is_fresh(k, i, carried, ncarried) or is_fresh(k, i, fresh, nfresh):
+        return False
+    dense_state(dense[2], dense[3], FRESH_S, tmp)
+    return row_value(k, i, tmp, model, pstate) > 0.0
+
+
+@helper_njit
+def _hand_back(carried, ncarried, fresh, nfresh, same_instant):
+    """The rows applied at the instant ``advance`` returns at, into ``carried``: this call's
+    fresh rows, and those carried in when time did not move. Returns their count."""
+    n = ncarried if same_instant else 0
+    for q in range(nfresh):
+        if not is_fresh(fresh[q, 0], fresh[q, 1], carried, n):
+            n = _mark(fresh[q, 0], fresh[q, 1], carried, n)
+    return n
+
+
+@helper_njit
 def _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
     """Apply the event of row (k, i) at (t, y), remember the row as fresh (its function sits
     on 0 at the restart) and, after a kink handled here, recompute f0 = f(y) in the new
     region. Returns (status or -1, nfresh)."""
     status = _apply(k, i, t, y, model, pstate, rows, log, iout)
-    if nfresh < MAX_FRESH:
-        fresh[nfresh, 0], fresh[nfresh, 1] = k, i
-        nfresh += 1
+    nfresh = _mark(k, i, fresh, nfresh)
     if status < 0:
         rhs(y, model, pstate, f0)
         iout[IO_NFEV] += 1
@@ -341,11 +387,13 @@ def _workspaces(y, model, pts):
 
 @helper_njit
 def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pts, vinv,
-         rows, log, iout, work):  # fmt: skip
-    """The stepping loop of ``advance`` from t (s) with first step h (s) and f0 = f(y) (work:
-    ``_workspaces``): returns (status, t, next step h, attempts)."""
+         rows, log, iout, work, carried, ncarried):  # fmt: skip
+    """The stepping loop of ``advance`` from t (s) with first step h (s), f0 = f(y) (work:
+    ``_workspaces``) and carried[:ncarried] the rows the previous call applied at t: returns
+    (status, t, next step h, attempts, nfresh: the rows in work's fresh applied at that t)."""
     K, ynew, tmp, dense, ws, count, plate_pair, fresh = work
     nfresh = np.int64(0)  # (typed int64, not a literal: one compiled signature per helper)
+    t0 = t
     pend_k, pend_i, pend_t = np.int64(-1), np.int64(-1), 0.0  # the pending event
     rejected = False
     attempts = 0
@@ -353,23 +401,23 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
         t_bound = pend_t if pend_k >= 0 else t_stop
         if t >= t_bound:
             if pend_k < 0:
-                return ST_STOP, t, h, attempts
+                return ST_STOP, t, h, attempts, nfresh
             status, nfresh = _apply_pending(pend_k, pend_i, t, y, model, pstate, rows, log, iout,
                                             fresh, nfresh, f0)  # fmt: skip
             pend_k = np.int64(-1)
             if status >= 0:
-                return status, t, h, attempts
+                return status, t, h, attempts, nfresh
             continue
         status = _limits(attempts, max_steps, nodes, model, pstate, rows, log, iout)
         if status >= 0:
-            return status, t, h, attempts
+            return status, t, h, attempts, nfresh
         last = h >= t_bound - t
         hh = t_bound - t if last else h
         if hh <= 4.0 * EPS * abs(t):
             if last:  # the bound is within round-off of t: snap to it
                 t = t_bound
                 continue
-            return ST_STEP_TINY, t, h, attempts
+            return ST_STEP_TINY, t, h, attempts, nfresh
         attempts += 1
         err = _attempt(y, hh, K, f0, tab, rtol, atol, model, pstate, ynew, tmp, iout)
         if not err <= 1.0:
@@ -380,6 +428,11 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
                                vinv, ws, iout, tmp)  # fmt: skip
         if k >= 0 and pend_k >= 0 and t + s * hh >= pend_t - SAME_TIME * hh:
             k = -1  # (about) simultaneous with the pending event: taken after it
+        if k >= 0 and _found_again(k, i, s, hh, t, t0, carried, ncarried, fresh, nfresh, dense,
+                                   model, pstate, tmp):  # fmt: skip
+            nfresh = _mark(k, i, fresh, nfresh)  # (its event was just applied: search again)
+            iout[IO_AGAIN] += 1
+            continue
         factor = growth(err, rejected)
         rejected = False
         if k < 0:
@@ -390,14 +443,14 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
             h = hh * factor
             if b >= 0:
                 iout[IO_INDEX] = b
-                return ST_SETTLE, t, h, attempts
+                return ST_SETTLE, t, h, attempts, nfresh
             continue
         t_e = t + s * hh
         if t_e <= t + 4.0 * EPS * abs(t) or s == 0.0:  # at the restart: apply there
             status, nfresh = _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh,
                                          nfresh, f0)  # fmt: skip
             if status >= 0:
-                return status, t, h, attempts
+                return status, t, h, attempts, nfresh
             continue
         pend_k, pend_i, pend_t = k, i, t_e  # redo the step to end exactly at the event
         h = t_e - t
@@ -405,7 +458,7 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
 
 @njit(cache=True)
 def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pts, vinv, rows,
-            log, iout):  # fmt: skip
+            log, iout, fresh):  # fmt: skip
     """Advance the active set from tio[0] with first step tio[1] until an event or t_stop.
 
     y (6 n + 2 m,) state in/out (m modes); atol (6 n + 2 m,) absolute tolerance per component.
@@ -415,14 +468,28 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
     tab = DOP853 (A, B, E3, E5, D). rows (R, 3) force rows (t, pair, F) and log (L, 3) kinks
     (t, kind, pair) are appended from iout[IO_ROWS], iout[IO_LOG]. On return: tio = [t, next
     step], iout[IO_STATUS] (ST_*), iout[IO_INDEX] (pair or ball), iout[IO_EDGE], work counts.
+
+    fresh (MAX_FRESH, 2) rows (kind, index) whose events were applied at tio[0], in/out: the
+    first iout[IO_FRESH] on entry (the caller passes those of the previous return when it
+    restarts at that time, else none) and on return those applied at the returned time
+    (with those carried in if time did not move). Their functions sit on 0 at the restart:
+    a crossing of one of them found at the restart instant (where it would be applied
+    there: the same event again) while the row is back on its side at ``FRESH_S`` of the
+    step makes it fresh for this call and the step is searched again, from ``FRESH_S`` on
+    for that row, so a genuine new crossing later in the step is still found; a row still
+    on the wrong side at ``FRESH_S`` crosses there genuinely and is applied at the restart.
+    Any other search is exactly as without the markers.
     """
     work = _workspaces(y, model, pts)
     K = work[0]
     rhs(y, model, pstate, K[0])
     iout[IO_NFEV] += 1
     f0 = K[0].copy()
-    status, t, h, attempts = _run(tio[0], tio[1], f0, y, t_stop, rtol, atol, max_steps, nodes,
-                                  model, pstate, tab, pts, vinv, rows, log, iout, work)  # fmt: skip
+    ncarried = np.int64(min(max(iout[IO_FRESH], 0), MAX_FRESH))
+    status, t, h, attempts, nfresh = _run(tio[0], tio[1], f0, y, t_stop, rtol, atol, max_steps,
+                                          nodes, model, pstate, tab, pts, vinv, rows, log, iout,
+                                          work, fresh, ncarried)  # fmt: skip
+    iout[IO_FRESH] = _hand_back(fresh, ncarried, work[7], nfresh, t == tio[0])
     if status == ST_START:
         h = min(h, first_contact_step(y, model, iout[IO_INDEX], rtol))
     tio[0] = t

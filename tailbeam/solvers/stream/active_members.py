@@ -5,7 +5,9 @@ members come and go (a ball lands, a neighbour comes within reach, a ball flies 
 set is rebuilt on the next ``advance`` after a change, carrying over each pair's state
 (touching, region flags, peak force, maximum penetration) by its key: (i, -1) for ball i on
 the plate, (i, j) with i < j for two balls. Every pair among the members is watched (sets are
-small: the balls near a contact).
+small: the balls near a contact). A set rebuilt at the instant of an event carries the rows
+whose events were applied then (``ActiveSet.fresh_rows``, by key), so that it does not
+apply the same event again at once (``active_kernel.advance``).
 
 On the modal plate each plate pair also gets the residual compliance (m/N) of the truncated
 modes at the point of its mode shapes (``StreamPlate.compliance``, cached by point): when its
@@ -20,7 +22,13 @@ import numpy as np
 from tailbeam.physics.contact_patch import load_radius
 from tailbeam.physics.contacts import PLATE
 from tailbeam.physics.incline import EDGES
-from tailbeam.solvers.stream.active_pairs import L_CRES, first_contact_step, settle_excess
+from tailbeam.solvers.stream.active_kernel import IO_AGAIN
+from tailbeam.solvers.stream.active_pairs import (
+    L_CRES,
+    R_EDGE,
+    first_contact_step,
+    settle_excess,
+)
 from tailbeam.solvers.stream.active_set import ActiveSet, law_table
 
 SHAPE_REUSE = 2.5e-4  # m: mode shapes computed within this distance are reused (modal plate)
@@ -44,6 +52,7 @@ class ActiveMembers:
         self.h = 0.0
         self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
         self.totals = {"kernel_steps": 0, "kernel_attempts": 0, "kernel_nfev": 0, "rebuilds": 0}
+        self.totals["events_found_again"] = 0  # at the instant they were applied (issue 7)
         self._shape_cache = {}  # ball -> (xy, mode shapes there): modal plate
         self._phi_xy = {}  # plate pair key -> the point (x, y) of its mode shapes
         self._load_radii = {}  # ball -> radius (m) of its load model (contact_patch)
@@ -74,6 +83,7 @@ class ActiveMembers:
         for q, i in enumerate(self.members):
             self._x[i], self._v[i] = self.set.x[q].copy(), self.set.v[q].copy()
         self._pairs = {k: self._pair_state(p) for k, p in self.index.items()}
+        self._fresh = self._fresh_by_key()
         if self.plate is not None:  # each plate pair keeps its mode shapes (its contact point)
             self._phi = {k: self.set.phi[p].copy() for k, p in self.index.items() if k[1] < 0}
             self._cres = {k: self.set.law[p, L_CRES] for k, p in self.index.items() if k[1] < 0}
@@ -106,8 +116,32 @@ class ActiveMembers:
                 s.touching[p], s.ramp[p], s.clamped[p], s.peak[p], s.t_peak[p], s.pen[p] = old[k]
         s.h = self.h
         self.local = local
+        self._carry_fresh(old)
         self.dirty = False
         self.totals["rebuilds"] += 1
+
+    def _fresh_by_key(self) -> tuple[float, list]:
+        """The built set's fresh rows (``ActiveSet.fresh_rows``: events just applied) by
+        pair key, or (ball, edge) for an edge row."""
+        t, rows = self.set.fresh_rows()
+        return t, [
+            (k, (self.members[i // 4], i % 4) if k == R_EDGE else self.keys[i]) for k, i in rows
+        ]
+
+    def _carry_fresh(self, old):
+        """A rebuilt set carries the fresh rows of the set it replaces (a restart at the
+        instant of an event must not find it again), translated to its own indices."""
+        if not old:
+            return
+        t, rows = getattr(self, "_fresh", (math.nan, []))
+        kept = []
+        for k, key in rows:
+            if k == R_EDGE:
+                if key[0] in self.local:
+                    kept.append((k, 4 * self.local[key[0]] + key[1]))
+            elif key in self.index:
+                kept.append((k, self.index[key]))
+        self.set.set_fresh(t, kept)
 
     def _modal_inputs(self, members) -> dict:
         """The modal block of a rebuilt set: the plate's state now, the mode shapes under
@@ -211,7 +245,9 @@ class ActiveMembers:
             self.totals["kernel_steps"] += st["steps"]
             self.totals["kernel_attempts"] += st["attempts"]
             self.totals["kernel_nfev"] += st["nfev"]
+            self.totals["events_found_again"] += st["found_again"]
             self.set.iout[3:6] = 0  # counted
+            self.set.iout[IO_AGAIN] = 0
 
     def _ready(self):
         if self.dirty:
@@ -310,6 +346,7 @@ class ActiveMembers:
         delta, _ = s.penetration(p)
         s.touching[p], s.ramp[p], s.clamped[p] = True, True, False
         s.peak[p], s.t_peak[p], s.pen[p] = 0.0, math.nan, max(delta, 0.0)
+        s.forget_fresh(p)
         self._set_compliance(key)
         step = first_contact_step(s.y, s.model(), p, self.rtol)
         self.h = min(self.h, step) if self.h else step
@@ -342,6 +379,7 @@ class ActiveMembers:
         s.ramp[p] = self.balls.static_pen[i] < law[3] or law[2] <= 0.0
         s.clamped[p] = False
         s.settle_energy[q] = 0.0
+        s.forget_fresh(p)
         self.quiet.add(i)
         return removed
 

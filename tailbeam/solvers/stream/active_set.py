@@ -13,6 +13,9 @@ The fast stream solver's driver advances balls in free flight in closed form and
   distances are polynomials of degree <= 14 on a step, certified positive by their
   Chebyshev coefficients or searched for their first crossing (``cheb_events``), so a grazing
   approach and retreat inside one step is not missed;
+* the rows whose events were applied at the time t a call returns at are carried into the
+  next call from t (``fresh_rows``, ``set_fresh``): one found crossing again right at t
+  while back on its side just after is searched again (``active_kernel.advance``);
 * SETTLE is checked at accepted step ends only: a ball whose only touching pair is the plate
   and whose normal excess energy over the static state (``active_pairs.settle_excess``)
   falls below its settle energy;
@@ -45,6 +48,7 @@ from tailbeam.solvers.rigid.kernel import dop853_tables
 from tailbeam.solvers.stream import active_kernel as ak
 from tailbeam.solvers.stream.active_pairs import (
     L_CRES,
+    R_EDGE,
     clamp_indicator,
     pair_state,
     plate_contact_energy,
@@ -53,6 +57,8 @@ from tailbeam.solvers.stream.cheb_events import tables as cheb_tables
 from tailbeam.solvers.stream.modal_block import ModalBlock
 
 DEFAULT_NODES = 40  # interior force rows per step: linear interpolation < 1e-5 of the peak
+CARRY_FRESH = True  # False: a restart forgets the events just applied (before issue 7's fix;
+# benchmarks/bench_event_restart.py compares both)
 
 
 @dataclass(frozen=True)
@@ -171,7 +177,9 @@ class ActiveSet:
         self.pts, self.vinv = cheb_tables()
         self.rows = np.zeros((int(row_capacity), 3))
         self.log = np.zeros((int(log_capacity), 3))
-        self.iout = np.zeros(8, dtype=np.int64)
+        self.iout = np.zeros(ak.IO_SIZE, dtype=np.int64)
+        self.fresh = np.zeros((ak.MAX_FRESH, 2), dtype=np.int64)
+        self.t_fresh = math.nan  # the time the rows in fresh were applied at
         self.h = 0.0
         self.open_overlapping()
 
@@ -244,25 +252,58 @@ class ActiveSet:
         """Stop integrating ball b (after a leave): its touching pairs end."""
         self.alive[b] = False
         self.touching[(self.pi == b) | (self.pj == b)] = False
+        for p in np.flatnonzero((self.pi == b) | (self.pj == b)):
+            self.forget_fresh(int(p))
+
+    # --- the events just applied (carried to the next call at the same time) ----------------
+    def fresh_rows(self) -> tuple[float, list]:
+        """(t s, [(kind, index)]): the rows whose events were applied at the time t the last
+        ``advance`` returned at (kind ``active_pairs.R_CONTACT``, ``R_FULL``, ``R_CLAMP``:
+        index a pair; ``R_EDGE``: index 4 ball + edge). The next call from t does not find
+        them again at t (``active_kernel.advance``)."""
+        n = int(self.iout[ak.IO_FRESH])
+        return self.t_fresh, [(int(k), int(i)) for k, i in self.fresh[:n]]
+
+    def set_fresh(self, t: float, rows):
+        """Rows (kind, index) whose events were applied at time t (s), as ``fresh_rows``
+        gives them: a set rebuilt at t carries those of the set it replaces."""
+        rows = list(rows)[: ak.MAX_FRESH]
+        for q, (k, i) in enumerate(rows):
+            self.fresh[q] = k, i
+        self.iout[ak.IO_FRESH] = len(rows)
+        self.t_fresh = float(t)
+
+    def forget_fresh(self, p: int):
+        """Pair p's state was changed by the caller: its rows are no longer fresh."""
+        t, rows = self.fresh_rows()
+        kept = [(k, i) for k, i in rows if k == R_EDGE or i != p]
+        if len(kept) < len(rows):
+            self.set_fresh(t, kept)
 
     # --- integration -----------------------------------------------------------------------
     def advance(self, t0: float, t_stop: float, h: float | None = None) -> Outcome:
         """Integrate from t0 until the first returning event or t_stop; see the module
         docstring. h: first step (s; default: the step suggested by the previous call, or
-        1e-5 s). Grows the force-row and log buffers as needed."""
+        1e-5 s). Grows the force-row and log buffers as needed. A call that starts at the
+        time the previous one returned at carries the rows whose events were applied then
+        (``fresh_rows``): one whose crossing sits on 0 there is not applied again at once
+        (``active_kernel.advance``)."""
         tio = np.array([float(t0), float(h or self.h or 1e-5)])
+        if tio[0] != self.t_fresh or not CARRY_FRESH:
+            self.iout[ak.IO_FRESH] = 0
         while True:
             self.iout[ak.IO_STATUS] = -1
             ak.advance(
                 tio, self.y, float(t_stop), self.rtol, self.atol, self.max_steps, self.nodes,
                 self.model(), self.pstate(), self.tab, self.pts, self.vinv, self.rows, self.log,
-                self.iout,
+                self.iout, self.fresh,
             )  # fmt: skip
             status = int(self.iout[ak.IO_STATUS])
             if status != ak.ST_BUFFER:
                 break
             self._grow()
         self.h = float(tio[1])
+        self.t_fresh = float(tio[0])
         if status == ak.ST_STEP_LIMIT:
             raise WorkLimitError(
                 f"active set: more than max_steps={self.max_steps} steps in one advance by "
@@ -302,9 +343,11 @@ class ActiveSet:
 
     @property
     def stats(self) -> dict:
-        """Accepted steps, attempted steps and right-hand-side evaluations so far."""
+        """Accepted steps, attempted steps, right-hand-side evaluations and events found
+        again at the instant they were applied (searched again: ``active_kernel.advance``)."""
         return {"steps": int(self.iout[ak.IO_STEPS]), "attempts": int(self.iout[ak.IO_ATTEMPTS]),
-                "nfev": int(self.iout[ak.IO_NFEV])}  # fmt: skip
+                "nfev": int(self.iout[ak.IO_NFEV]),
+                "found_again": int(self.iout[ak.IO_AGAIN])}  # fmt: skip
 
 
 def _with_compliance(laws, pj, compliance) -> np.ndarray:

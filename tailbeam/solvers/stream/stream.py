@@ -51,7 +51,8 @@ DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
 DEFAULT_MAX_STEPS = 50_000_000  # kernel steps + events: the work bound
 MAX_PARTICLES = 200_000  # per scene: memory ~40 kB per particle (records, force histories)
-GRAZING_RETRIES = 2  # runs again at rtol / 10, / 100 after a grazing contact stalls it
+GRAZING_RETRIES = 2  # runs again at rtol / 10, / 100 after a stall at one instant: a last
+# safety net (the kernel no longer finds an event again at the instant it applied it)
 WORK_CHECK_EVERY = 16  # loop rounds between two checks of the work bound
 STUCK_LIMIT = 5_000  # loop rounds without time moving before the run is stopped
 
@@ -165,7 +166,9 @@ def _run(sim, duration, progress) -> "StreamRun":
 
 
 class _Stuck(WorkLimitError):
-    """Contacts start and end again at one instant: no progress (a grazing contact)."""
+    """Contacts start and end again at one instant: no progress (a grazing contact). The
+    active set carries the events it applied at an instant into its next call from there
+    (``active_kernel.advance``), the cause seen before; the retry stays as a safety net."""
 
 
 class _CallbackBar:
