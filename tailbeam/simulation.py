@@ -19,6 +19,7 @@ Running one scene through two solvers is how a user checks one against the other
 """
 
 import contextlib
+import math
 
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.progress import note, quiet, task
@@ -120,13 +121,17 @@ def _through_stream(scene, how, reference: bool):
 
 def _band_warning(band) -> str:
     """One line: the stream's band is below what its shortest plate contact needs."""
+    error = band["truncation_force_error"]
+    estimate = (
+        f"estimated error up to {error:.1%} (an upper estimate: measured 0.04-0.85 of it"
+        if math.isfinite(error)
+        else "the band stops below that contact's own frequency (no error estimate"
+    )
     return (
         f"modal band 0-{band['fmax_hz'] / 1e3:g} kHz ({band['reason']}): the shortest plate "
         f"contacts ({band['hardest_contact']}, {band['contact_duration_min_s'] * 1e6:.0f} us) "
-        "would need "
-        f"{band['fmax_contact_hz'] / 1e3:.1f} kHz for a {band['accuracy']:.1%} peak force; "
-        f"estimated error up to {band['truncation_force_error']:.1%} (an upper estimate: "
-        "measured 0.04-0.85 of it; docs/streams.md, band and particle size)"
+        f"would need {band['fmax_contact_hz'] / 1e3:.1f} kHz for a {band['accuracy']:.1%} peak "
+        f"force; {estimate}; docs/streams.md, band and particle size)"
     )
 
 

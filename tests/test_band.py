@@ -206,3 +206,6 @@ def test_stream_band_estimates_the_shortest_contact_as_a_single_ball_would():
         assert band["truncation_force_error"] > auto.BAND_ACCURACY  # 10 mm lumps at 10 kHz
     line = _band_warning(band)
     assert "\n" not in line and "would need" in line and band["hardest_contact"] in line
+    # a band below the pulse's own frequency has no estimate (inf), and says so, not "inf%"
+    line = _band_warning(dict(band, truncation_force_error=float("inf")))
+    assert "inf" not in line and "no error estimate" in line
