@@ -101,22 +101,33 @@ def choose_solver(scene, solver: str = "auto", field: str = "solver") -> str:
 
 def _through_stream(scene, how, reference: bool):
     """``scene`` through the fast stream solver (or its reference), then its sensors."""
-    from tailbeam.solvers.coupled.auto import stream_band_estimate
     from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene
 
     check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
     if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
         note("tail: quasi-static (the stream solver: contact points are not known in advance)")
     band = stream_band(scene) if scene.plate_model == "modal" else None
-    if band:  # (the band check: here, not in stream_band, which sweeps call per case)
-        band.update(stream_band_estimate(scene, band["fmax_hz"], band["residual_flexibility"]))
-        if band["truncation_force_error"] > band["accuracy"]:
-            note(_band_warning(band))
+    if band:  # (here, not in stream_band, which a sweep's client calls for every case)
+        warning = check_stream_band(scene, band)
+        if warning:
+            note(warning)
     plate = _stream_plate(scene, band) if band and band["two_way"] else None
     result = _stream(scene, how, plate, reference)
     if band:
         _modal_sensors(scene, result, band, plate)
     return result
+
+
+def check_stream_band(scene, band: dict) -> str | None:
+    """Add the band check of a stream scene to its ``band`` (``stream_band``; the keys of
+    ``tailbeam.solvers.coupled.auto.stream_band_estimate``); the one line to show when the
+    band is below what the shortest plate contact needs, else None."""
+    from tailbeam.solvers.coupled.auto import stream_band_estimate
+
+    band.update(stream_band_estimate(scene, band["fmax_hz"], band["residual_flexibility"]))
+    if band.get("truncation_force_error", 0.0) > band["accuracy"]:
+        return _band_warning(band)
+    return None
 
 
 def _band_warning(band) -> str:

@@ -168,6 +168,7 @@ def _submit(client, todo: list) -> dict:
         groups.setdefault(c.basis, []).append(c)
     futures = {}
     for members in groups.values():
+        _band_note(members[0].toml)
         warm = client.submit(warm_basis, members[0].toml, key=f"tailbeam-basis-{uuid.uuid4().hex}")
         n = len(members)
         keys = [f"tailbeam-case-{c.hash[:16]}-{uuid.uuid4().hex[:8]}" for c in members]
@@ -177,6 +178,18 @@ def _submit(client, todo: list) -> dict:
         ):
             futures[fut] = case
     return futures
+
+
+def _band_note(toml: str) -> None:
+    """The stream band check (tailbeam.simulation.check_stream_band) of a basis group's first
+    case, said once: the cases themselves run quietly."""
+    from tailbeam.simulation import check_stream_band, stream_band
+
+    scene = loads_scene(toml)
+    if scene.needs_stream_solver and scene.plate_model == "modal":
+        warning = check_stream_band(scene, stream_band(scene))
+        if warning:
+            note(f"{warning} [first case of its basis]")
 
 
 def _pause(futures: dict, rate: float) -> None:
