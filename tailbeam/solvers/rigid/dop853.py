@@ -77,19 +77,24 @@ def dense_coefficients(K, A, D, y0, y1, n0, n1, f0, f1, h, ramp, clamped, par, c
     """The 7 x 2 dense-output coefficients ``coef`` of an accepted step of h (s) from
     (y0 m, y1 m/s) to (n0, n1) (3 extra stages into K[13..15]; ``regions.dense_eval``)."""
     stages(K, A, 13, 16, y0, y1, h, ramp, clamped, par)
-    for q in range(2):
-        yq_old = y0 if q == 0 else y1
-        yq_new = n0 if q == 0 else n1
-        dy = yq_new - yq_old
-        fo = f0 if q == 0 else f1
-        coef[0, q] = dy
-        coef[1, q] = h * fo - dy
-        coef[2, q] = 2.0 * dy - h * (K[12, q] + fo)
-        for i in range(4):
-            acc = 0.0
-            for j in range(16):
-                acc += D[i, j] * K[j, q]
-            coef[3 + i, q] = h * acc
+    dense_rows(coef, 0, n0 - y0, h, f0, K, D)
+    dense_rows(coef, 1, n1 - y1, h, f1, K, D)
+
+
+@helper_njit
+def dense_rows(coef, q, dy, h, f_start, K, D):
+    """Rows 0-6 of component q of DOP853's dense output (scipy's F) after a step of h (s)
+    that changed it by dy, with f_start its derivative at the step's start and K (16, .)
+    the step's stages (the extra three included); D the dense-output table. Shared by the
+    rigid and the stream kernels."""
+    coef[0, q] = dy
+    coef[1, q] = h * f_start - dy
+    coef[2, q] = 2.0 * dy - h * (K[12, q] + f_start)
+    for i in range(4):
+        acc = 0.0
+        for j in range(16):
+            acc += D[i, j] * K[j, q]
+        coef[3 + i, q] = h * acc
 
 
 @helper_njit

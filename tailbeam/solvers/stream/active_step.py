@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from tailbeam.solvers.jit import helper_njit
+from tailbeam.solvers.rigid.dop853 import dense_rows
 from tailbeam.solvers.stream.active_pairs import rhs, rhs_arrays
 
 EPS = 2.220446049250313e-16
@@ -86,15 +87,7 @@ def dense_coef(y, ynew, h, K, tab, model, pstate, coef, tmp):
     A, D = tab[0], tab[4]
     stages(K, A, np.int64(13), np.int64(16), y, h, model, pstate, tmp)
     for q in range(y.shape[0]):
-        dy = ynew[q] - y[q]
-        coef[0, q] = dy
-        coef[1, q] = h * K[0, q] - dy
-        coef[2, q] = 2.0 * dy - h * (K[12, q] + K[0, q])
-        for i in range(4):
-            acc = 0.0
-            for j in range(16):
-                acc += D[i, j] * K[j, q]
-            coef[3 + i, q] = h * acc
+        dense_rows(coef, q, ynew[q] - y[q], h, K[0, q], K, D)
 
 
 @helper_njit
