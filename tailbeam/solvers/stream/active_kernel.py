@@ -31,7 +31,7 @@ A row whose event was just applied sits on 0 at the restart ("fresh": searched f
 carried into the next call that starts at that instant (``active_set.ActiveSet.advance``;
 the stream driver carries them into a set rebuilt then, ``active_members``). A carried row
 whose crossing is found at the restart instant while it is back on its side at FRESH_S is
-searched again as fresh (``_found_again``): a START or END returned to the caller is not
+searched again as fresh (``active_fresh.found_again``): a START or END returned to the caller is not
 applied again at once where its row sat on 0 (the grazing stall of issue 7); a row still on
 its wrong side there, and a genuine new crossing later in the step, are found as before.
 """
@@ -44,7 +44,8 @@ from numba import njit
 from tailbeam.solvers.jit import helper_njit
 from tailbeam.solvers.records import EventKind
 from tailbeam.solvers.rigid.dop853 import growth, shrink
-from tailbeam.solvers.stream.active_events import detect, is_fresh, prepare
+from tailbeam.solvers.stream.active_events import detect, prepare
+from tailbeam.solvers.stream.active_fresh import MAX_FRESH, found_again, hand_back, mark
 from tailbeam.solvers.stream.active_pairs import (
     R_CONTACT,
     R_EDGE,
@@ -63,13 +64,12 @@ from tailbeam.solvers.stream.active_step import (
     dense_coef,
     dense_component,
     dense_projected,
-    dense_state,
     dop853_step,
     ensure_ball,
     ensure_plate,
     project_plate,
 )
-from tailbeam.solvers.stream.cheb_events import FRESH_S, interpolant_max
+from tailbeam.solvers.stream.cheb_events import interpolant_max
 
 # return status of ``advance``
 ST_STOP, ST_START, ST_END, ST_LEAVE, ST_SETTLE, ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = range(8)
@@ -87,7 +87,6 @@ IO_FRESH, IO_AGAIN = 8, 9
 IO_SIZE = 10
 
 SAME_TIME = 1e-9  # fraction of a step: events closer than this to a pending one wait for it
-MAX_FRESH = 16
 
 
 @helper_njit
@@ -218,48 +217,12 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
 
 
 @helper_njit
-def _mark(k, i, fresh, nfresh):
-    """Remember row (k, i) as fresh (up to MAX_FRESH rows); returns the new count."""
-    if nfresh < MAX_FRESH:
-        fresh[nfresh, 0], fresh[nfresh, 1] = k, i
-        nfresh += 1
-    return nfresh
-
-
-@helper_njit
-def _found_again(k, i, s, h, t, t0, carried, ncarried, fresh, nfresh, dense, model, pstate,
-                 tmp):  # fmt: skip
-    """Whether the crossing of row (k, i) at fraction s of the step of h (s) from t (s) is the
-    event the previous call applied and returned at t0 = t (``carried``) found again: at
-    the restart instant (where it would be applied there), not yet marked fresh in this
-    call, and back on its side at ``FRESH_S`` of the step (it sat on 0; a row still on the
-    wrong side there crosses now, genuinely: applied at the restart as without markers)."""
-    if ncarried == 0 or t != t0 or not (t + s * h <= t + 4.0 * EPS * abs(t) or s == 0.0):
-        return False
-    if not is_fresh(k, i, carried, ncarried) or is_fresh(k, i, fresh, nfresh):
-        return False
-    dense_state(dense[2], dense[3], FRESH_S, tmp)
-    return row_value(k, i, tmp, model, pstate) > 0.0
-
-
-@helper_njit
-def _hand_back(carried, ncarried, fresh, nfresh, same_instant):
-    """The rows applied at the instant ``advance`` returns at, into ``carried``: this call's
-    fresh rows, and those carried in when time did not move. Returns their count."""
-    n = ncarried if same_instant else 0
-    for q in range(nfresh):
-        if not is_fresh(fresh[q, 0], fresh[q, 1], carried, n):
-            n = _mark(fresh[q, 0], fresh[q, 1], carried, n)
-    return n
-
-
-@helper_njit
 def _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
     """Apply the event of row (k, i) at (t, y), remember the row as fresh (its function sits
     on 0 at the restart) and, after a kink handled here, recompute f0 = f(y) in the new
     region. Returns (status or -1, nfresh)."""
     status = _apply(k, i, t, y, model, pstate, rows, log, iout)
-    nfresh = _mark(k, i, fresh, nfresh)
+    nfresh = mark(k, i, fresh, nfresh)
     if status < 0:
         rhs(y, model, pstate, f0)
         iout[IO_NFEV] += 1
@@ -428,9 +391,9 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
                                vinv, ws, iout, tmp)  # fmt: skip
         if k >= 0 and pend_k >= 0 and t + s * hh >= pend_t - SAME_TIME * hh:
             k = -1  # (about) simultaneous with the pending event: taken after it
-        if k >= 0 and _found_again(k, i, s, hh, t, t0, carried, ncarried, fresh, nfresh, dense,
+        if k >= 0 and found_again(k, i, s, hh, t, t0, carried, ncarried, fresh, nfresh, dense,
                                    model, pstate, tmp):  # fmt: skip
-            nfresh = _mark(k, i, fresh, nfresh)  # (its event was just applied: search again)
+            nfresh = mark(k, i, fresh, nfresh)  # (its event was just applied: search again)
             iout[IO_AGAIN] += 1
             continue
         factor = growth(err, rejected)
@@ -489,7 +452,7 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
     status, t, h, attempts, nfresh = _run(tio[0], tio[1], f0, y, t_stop, rtol, atol, max_steps,
                                           nodes, model, pstate, tab, pts, vinv, rows, log, iout,
                                           work, fresh, ncarried)  # fmt: skip
-    iout[IO_FRESH] = _hand_back(fresh, ncarried, work[7], nfresh, t == tio[0])
+    iout[IO_FRESH] = hand_back(fresh, ncarried, work[7], nfresh, t == tio[0])
     if status == ST_START:
         h = min(h, first_contact_step(y, model, iout[IO_INDEX], rtol))
     tio[0] = t
