@@ -17,6 +17,7 @@ from tailbeam.plate.kirchhoff import ELEMENT_NAME as KIRCHHOFF_ELEMENT
 from tailbeam.plate.kirchhoff import assemble_kirchhoff
 from tailbeam.plate.mesh import check_mesh, default_mesh, load_mesh
 from tailbeam.plate.mindlin import DEFAULT_DEGREE, assemble_mindlin
+from tailbeam.plate.probes import PointProbe
 from tailbeam.plate.sparse_solve import SymmetricSolver
 
 THEORIES = ("kirchhoff", "mindlin")
@@ -62,6 +63,7 @@ class PlateModel:
     deflection_basis: Basis
     w_offset: int = 0
     _solver: SymmetricSolver | None = field(default=None, repr=False)
+    _probe: PointProbe | None = field(default=None, repr=False)
 
     @property
     def n_dofs(self) -> int:
@@ -77,7 +79,9 @@ class PlateModel:
     def deflection_operator(self, points) -> sp.csr_matrix:
         """(p, n) sparse matrix: deflection (m) at points (p, 2) from free-DOF vectors."""
         pts = check_points(self.plate, points)
-        probe = self.deflection_basis.probes(pts.T).tocsr()
+        if self._probe is None:
+            self._probe = PointProbe(self.deflection_basis)
+        probe = self._probe.operator(pts)
         full = sp.csr_matrix(
             (probe.data, probe.indices + self.w_offset, probe.indptr),
             shape=(probe.shape[0], self.n_full),

@@ -21,6 +21,7 @@ from tailbeam.plate.closed_forms import bending_wavenumber, ssss_kirchhoff_frequ
 from tailbeam.plate.cost import SolveCost, check_cost, mesh_dofs, solve_cost
 from tailbeam.plate.mindlin import DEFAULT_DEGREE
 from tailbeam.plate.model import PlateModel, assemble_plate, check_points, resolve_mesh
+from tailbeam.plate.probes import PointProbe
 from tailbeam.plate.resolution import DEFAULT_FMAX_HZ, resolve
 from tailbeam.plate.sparse_solve import count_eigenvalues_below, lowest_modes
 from tailbeam.progress import task
@@ -206,14 +207,15 @@ def _make_basis(
     the same key in this process share their assembled FE model (see _shared_state)."""
     full = np.zeros((n_full, vectors.shape[1]))
     full[free_dofs] = vectors
-    probe = {"basis": probe_basis}
+    probe = {"basis": probe_basis, "fast": None}
 
     def deflection_at(points):
-        if probe["basis"] is None:
-            probe["basis"] = _probe_basis(mesh, theory, degree)
-        pts = check_points(plate, points)
-        op = probe["basis"].probes(pts.T)  # the deflection DOFs come first in the vector
-        return np.asarray(op @ full[: op.shape[1]])
+        if probe["fast"] is None:
+            if probe["basis"] is None:
+                probe["basis"] = _probe_basis(mesh, theory, degree)
+            probe["fast"] = PointProbe(probe["basis"])
+        # the deflection DOFs come first in the vector
+        return probe["fast"].values(check_points(plate, points), full)
 
     basis = FEModalBasis(
         plate=plate,
