@@ -83,6 +83,10 @@ def _check_case(one, rows, toml):
     assert int(one["n_gangue"]) == labels.count("gangue")
     assert int(one["n_coal"]) == labels.count("coal")
     assert int(one["n_particles"]) == len(labels) > 0
+    # the band it ran with and the band check's estimate, as the direct run reports them
+    band = direct.info["band"]
+    assert float(one["band_hz"]) == band["fmax_hz"] == 3000.0
+    assert float(one["band_force_error"]) == band["truncation_force_error"] > band["accuracy"]
     assert len(rows) == len(table["ball"])
     np.testing.assert_array_equal(rows["ball"], table["ball"])
     np.testing.assert_array_equal(rows["label"], table["label"])

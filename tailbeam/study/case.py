@@ -7,6 +7,7 @@ one-line error instead of raising, so one bad case never stops a sweep.
 """
 
 import json
+import math
 import time
 import traceback
 
@@ -17,7 +18,10 @@ from tailbeam.progress import quiet
 
 def basis_signature(scene) -> str:
     """A key shared by the cases that use the same modal basis (plate, boundary, theory, mesh,
-    band): a sweep warms the cache once per key before its cases run."""
+    band): a sweep warms the cache once per key before its cases run; "" on the rigid
+    plate (no basis)."""
+    if scene.plate_model != "modal":
+        return ""
     m = scene.modal
     p = scene.plate
     mat = p.material
@@ -57,6 +61,8 @@ def warm_basis(scene_toml: str) -> str:
 
     try:
         scene = loads_scene(scene_toml)
+        if scene.plate_model != "modal":
+            return "rigid plate: no basis"
         band = stream_band(scene) if scene.needs_stream_solver else None
         with quiet():  # a worker's notes and bars would interleave on the user's terminal
             basis = build_basis(scene, band)
@@ -82,6 +88,17 @@ def _impact_rows(result) -> list:
     return [{k: v.item() if isinstance(v, np.generic) else v for k, v in r.items()} for r in rows]
 
 
+def _band_columns(result) -> dict:
+    """The modal band a case ran with (Hz) and the band check's upper estimate of its
+    peak-force error (tailbeam.solvers.coupled.auto: for a stream, at its hardest plate
+    contact); none on the rigid plate (the dataset then records NaN)."""
+    band = result.info.get("band") or {}
+    if "fmax_hz" not in band:
+        return {}
+    error = band.get("truncation_force_error", math.nan)
+    return {"band_hz": float(band["fmax_hz"]), "band_force_error": float(error)}
+
+
 def _counts(rows: list, stream: bool) -> dict:
     """Coal and gangue impacts on the plate (ball-ball rows are not plate impacts) and, for
     streams, the number of ball-ball contacts (each gives two rows)."""
@@ -97,7 +114,8 @@ def run_case(scene_toml: str, *_after) -> dict:
     """Simulate one case. Returns {"status": "ok" | "failed", "error", "wall_time",
     "cpu_time" (s, this process),
     "signals": {sensor: float32 array m/s^2}, "impacts": [row dicts], "n_coal_impacts",
-    "n_gangue_impacts" (plate impacts), and for a stream scene "n_ball_contacts"}.
+    "n_gangue_impacts" (plate impacts), for a stream scene "n_ball_contacts", and on the
+    modal plate "band_hz" and "band_force_error" (``_band_columns``)}.
     ``_after`` are ignored (Dask dependencies, e.g. the warmed basis; callers before the
     labels moved into the scene passed the coal materials here)."""
     from tailbeam.commands.simulate import solve
@@ -120,6 +138,7 @@ def run_case(scene_toml: str, *_after) -> dict:
                 for name, (_t, a) in result.sensor_signals.items()
             }
             out["impacts"] = _impact_rows(result)
+            out.update(_band_columns(result))
             out["status"] = "ok"
     except Exception as err:  # noqa: BLE001 - any failure is recorded, never raised
         out["error"] = _one_line(err) or traceback.format_exc().splitlines()[-1]

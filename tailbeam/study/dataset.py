@@ -4,8 +4,10 @@
   in m/s^2 as each sensor recorded it (chain and noise included); coordinates of ``case``: the
   case hash, seed, repeat, labels (``label``, ``gangue_fraction``, ``n_coal``, ``n_gangue``,
   ``n_coal_impacts``, ``n_gangue_impacts``; for stream scenes also ``gangue_mass_fraction``,
-  ``n_particles``, ``n_ball_contacts``) and every swept value (vector values one
-  coordinate per component, ``key[i]``); ``sensor_x``, ``sensor_y`` (case, sensor) in m.
+  ``n_particles``, ``n_ball_contacts``), the modal band ``band_hz`` and the band check's
+  estimate of the peak-force error ``band_force_error`` (NaN on the rigid plate), and every
+  swept value (vector values one coordinate per component, ``key[i]``); ``sensor_x``,
+  ``sensor_y`` (case, sensor) in m.
   Attributes: units, sample rate (Hz), duration (s), the base sensor positions, the tailbeam
   version, the sweep file, and ``case_scenes`` (case hash -> the case's scene TOML).
   Finished cases are appended along ``case``; open it with ``xarray.open_zarr(DIR/dataset.zarr)``.
@@ -42,6 +44,8 @@ LABEL_COLUMNS = (
 # labels of stream scenes only (tailbeam.study.labels.stream_labels, tailbeam.study.case)
 STREAM_LABEL_COLUMNS = ("gangue_mass_fraction", "n_particles")
 STREAM_RESULT_COLUMNS = ("n_ball_contacts",)
+# the modal band of a case and the band check's estimate of its peak-force error (NaN: rigid)
+BAND_COLUMNS = ("band_hz", "band_force_error")
 LEDGER_COLUMNS = (
     "case",
     "case_hash",
@@ -169,6 +173,7 @@ class DatasetStore:
                 "n_coal_impacts": result["n_coal_impacts"],
                 "n_gangue_impacts": result["n_gangue_impacts"],
                 **{k: result[k] for k in STREAM_RESULT_COLUMNS if k in result},
+                **{k: result.get(k, float("nan")) for k in BAND_COLUMNS},
                 **flat_params(case.params),
             }
             rows.append(row)
@@ -203,7 +208,10 @@ class DatasetStore:
         existing = self.zarr_path.exists()
         scenes = {case.hash: case.toml for _r, case, _res in ok}
         if existing:
-            scenes = {**zarr.open_group(self.zarr_path, mode="r").attrs["case_scenes"], **scenes}
+            group = zarr.open_group(self.zarr_path, mode="r")
+            scenes = {**group.attrs["case_scenes"], **scenes}
+            # a store written by an older tailbeam lacks the newer per-case values
+            ds = ds.drop_vars([name for name in ds.coords if name not in group])
         ds.attrs["case_scenes"] = scenes
         with warnings.catch_warnings():
             # consolidated metadata is not in the Zarr v3 spec yet; xarray reads it, and
