@@ -42,7 +42,8 @@ SIZES = (0.010, 0.015, 0.020, 0.030, 0.040)
 def contact_point(material: str, radius: float, speed: float, fmax: float) -> dict:
     """The ball, its plate law and the plate's modes, damping and residual compliance at
     POINT for a basis to ``fmax`` Hz."""
-    text = SCENE.format(fmax=fmax, material=material, radius=radius, z=radius + 1e-4, vz=-speed)
+    text = SCENE.format(fmax=fmax, material=material, radius=radius, z=radius + 1e-4, vz=-speed,
+                        extra="")  # fmt: skip
     scene = loads_scene(text)
     plate = _stream_plate(scene, {"fmax_hz": fmax})
     ball = scene.balls[0]

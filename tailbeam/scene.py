@@ -5,7 +5,7 @@ Reading scene files lives in ``tailbeam.io.scene_file``; this module holds no I/
 
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from tailbeam.errors import (
     InputError,
@@ -37,6 +37,7 @@ THEORIES = ("auto", "kirchhoff", "mindlin")
 COUPLINGS = ("two-way", "one-way")
 TAILS = ("auto", "quasi-static", "ritz")
 DEFAULT_TAIL_MODES = 32  # Ritz pseudo-modes per contact point (docs/fe-convergence.md)
+STREAM_TAIL_MODES = 4  # a stream contact's tail oscillators (tailbeam.solvers.stream.contact_tail)
 
 
 @dataclass(frozen=True)
@@ -79,13 +80,16 @@ class ModalPlateSettings:
     residual_flexibility: add the static compliance of the truncated modes at contacts.
     coupling: "two-way" or "one-way" (rigid-plate forces applied to the plate).
     tail: how the truncated modes act at a contact: "quasi-static" (their static compliance),
-    "ritz" (load-dependent Ritz pseudo-modes at the balls' first contact points,
-    tailbeam.solvers.coupled.ritz_prepass; needs residual_flexibility and two-way coupling) or
-    "auto" (the default: "ritz" where it applies, the coupled solver on an FE basis with
-    both; "quasi-static" elsewhere, saying why).
-    tail_modes: Ritz pseudo-modes per contact point, a whole number >= 1 (default 32:
-    within 2e-5 of the full FE at 20 kHz on the default and the test meshes) or "auto"
-    (chosen per point, a posteriori; costs 0.9-2.5 s per point).
+    "ritz" (load-dependent Ritz pseudo-modes: on the coupled solver at the balls' first
+    contact points, tailbeam.solvers.coupled.ritz_prepass; on the stream solver a few
+    oscillators at every plate contact, tailbeam.solvers.stream.contact_tail; needs
+    residual_flexibility and two-way coupling) or "auto" (the default: "ritz" where it
+    applies, the coupled solver on an FE basis with both; "quasi-static" elsewhere, streams
+    included, saying why).
+    tail_modes: Ritz pseudo-modes per contact point, a whole number >= 1, "auto" (chosen per
+    point, a posteriori, 0.9-2.5 s per point; the coupled solver only) or None: the solver's
+    default, 32 on the coupled solver (within 2e-5 of the full FE at 20 kHz on the default
+    and the test meshes), 4 per contact on the stream solver (``tail_modes_for``).
     """
 
     boundary: str = "SSSS"
@@ -97,7 +101,7 @@ class ModalPlateSettings:
     residual_flexibility: bool = True
     coupling: str = "two-way"
     tail: str = "auto"
-    tail_modes: int | str = DEFAULT_TAIL_MODES
+    tail_modes: int | str | None = None
 
     def __post_init__(self):
         code = self.boundary
@@ -131,11 +135,19 @@ class ModalPlateSettings:
                 raise InputError("plate.mesh_divisions", f"must be a whole number >= 1, got {n!r}")
         self._check_tail()
 
+    def tail_modes_for(self, stream: bool) -> int | str:
+        """plate.tail_modes as the solver uses it: the set value, else its default
+        (STREAM_TAIL_MODES on the stream solver, DEFAULT_TAIL_MODES on the coupled one)."""
+        if self.tail_modes is not None:
+            return self.tail_modes
+        return STREAM_TAIL_MODES if stream else DEFAULT_TAIL_MODES
+
     def _check_tail(self):
         if self.tail not in TAILS:
             raise InputError("plate.tail", f"must be one of {TAILS}, got {self.tail!r}")
         k = self.tail_modes
-        if k != "auto" and (isinstance(k, bool) or not isinstance(k, int) or k < 1):
+        whole = isinstance(k, int) and not isinstance(k, bool) and k >= 1
+        if k is not None and k != "auto" and not whole:
             raise InputError(
                 "plate.tail_modes", f"must be 'auto' or a whole number >= 1, got {k!r}"
             )
@@ -245,6 +257,9 @@ class Scene:
             raise InputError("sensors", "sensor names must be unique")
         if self.plate_model == "modal" and self.modal is None:
             object.__setattr__(self, "modal", ModalPlateSettings())
+        if self.modal is not None and self.modal.tail_modes is None:  # the solver's default
+            k = self.modal.tail_modes_for(self.needs_stream_solver)
+            object.__setattr__(self, "modal", replace(self.modal, tail_modes=k))
 
     def _check_labels(self) -> None:
         labels = tuple(self.labels) or tuple(default_label(b) for b in self.balls)

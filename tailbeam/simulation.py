@@ -103,9 +103,10 @@ def _through_stream(scene, how, reference: bool):
     """``scene`` through the fast stream solver (or its reference), then its sensors."""
     from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene
 
-    check_tail_scene(scene)  # before any work: "ritz" is the coupled solver's
+    check_tail_scene(scene)  # before any work
     if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
-        note("tail: quasi-static (the stream solver: contact points are not known in advance)")
+        note("tail: quasi-static (the stream solver's default; plate.tail = 'ritz' gives each "
+             "contact a few oscillators for the modes above the band)")  # fmt: skip
     band = stream_band(scene) if scene.plate_model == "modal" else None
     if band:  # (here, not in stream_band, which a sweep's client calls for every case)
         warning = check_stream_band(scene, band)
@@ -240,7 +241,44 @@ def _stream_plate(scene, band):
 
     basis, zeta = _basis_and_damping(scene, band)
     settings = scene.modal or ModalPlateSettings()
-    return StreamPlate(basis, zeta, residual_flexibility=settings.residual_flexibility)
+    tail = _contact_tail(scene, band, basis) if settings.tail == "ritz" else None
+    return StreamPlate(basis, zeta, residual_flexibility=settings.residual_flexibility, tail=tail)
+
+
+def _contact_tail(scene, band, basis):
+    """The oscillators of a stream's contacts (tailbeam.solvers.stream.contact_tail), from a
+    basis to TAIL_BAND_FACTOR x the band (computed once, cached)."""
+    from tailbeam.solvers.coupled.solver import modal_damping
+    from tailbeam.solvers.stream.contact_tail import TAIL_BAND_FACTOR, ContactTail
+
+    settings = scene.modal
+    wide_hz = TAIL_BAND_FACTOR * band["fmax_hz"]
+    wide = _tail_basis(scene, band, basis, wide_hz)
+    k = settings.tail_modes_for(stream=True)
+    note(
+        f"tail: {k} oscillators at each plate contact for the modes between "
+        f"{band['fmax_hz'] / 1e3:g} and {wide_hz / 1e3:g} kHz ({wide.n_modes} modes, "
+        "plate.tail = 'ritz'), the static spring above"
+    )
+    band["tail"] = {"model": "ritz", "oscillators": int(k), "tail_band_hz": wide_hz}
+
+    def damping(nu):
+        return modal_damping(nu, settings.damping_ratio, settings.rayleigh)
+
+    return ContactTail(basis.omega, wide, k, damping)
+
+
+def _tail_basis(scene, band, basis, wide_hz):
+    """The basis of a stream's contact tails: to ``wide_hz`` on the band basis' own FE mesh
+    (its modes below the band are the band's; the mesh the wider band alone would choose is
+    ~5x larger and takes minutes), or a closed form to ``wide_hz``."""
+    from tailbeam.plate import compute_modes
+    from tailbeam.solvers.coupled.auto import build_basis
+
+    if "divisions" not in basis.info:  # a closed form
+        return build_basis(scene, {**band, "fmax_hz": wide_hz})
+    return compute_modes(scene.plate, basis.boundary, theory=basis.info["theory"],
+                         fmax_hz=wide_hz, divisions=basis.info["divisions"])  # fmt: skip
 
 
 def _modal_sensors(scene, result, band, plate):

@@ -126,7 +126,10 @@ velocity = [0.0, 0.0, -1.0]
 
 def test_scene_key_end_to_end(capsys):
     scene = loads_scene(SCENE)
+    # the solver's default, set by the scene: 32 on the coupled solver (4 for a stream's
+    # contacts, tests/test_stream_tail.py)
     assert scene.modal.tail == "ritz" and scene.modal.tail_modes == 32
+    assert ModalPlateSettings(tail="ritz").tail_modes is None
     assert loads_scene(SCENE.replace('tail = "ritz"', 'tail = "ritz"\ntail_modes = 16')).modal == (
         ModalPlateSettings(
             theory="kirchhoff", mesh_divisions=8, fmax_hz=BAND, tail="ritz", tail_modes=16
@@ -169,13 +172,14 @@ def test_bad_tail_settings_name_the_field(new, field, rule_part):
     assert "\n" not in str(info.value)
 
 
-def test_ritz_needs_an_fe_basis_and_the_coupled_solver():
+def test_ritz_needs_an_fe_basis_and_a_number_on_the_stream_solver():
     ball = Ball("b", SANDSTONE, R, (*IMPACT, R + 1e-5), (0.0, 0.0, -1.0))
     with pytest.raises(InputError, match=r"^plate\.tail: .*closed form"):
         ritz_tail_basis(_scene([ball]), ssss_kirchhoff_basis(Plate(), BAND))
+    # the stream solver has its own "ritz" (oscillators at every contact): a number, not "auto"
     inclined = Scene((ball,), Plate(), plate_model="modal", inclination=10.0,
-                     modal=ModalPlateSettings(tail="ritz"))  # fmt: skip
-    with pytest.raises(InputError, match=r"^plate\.tail: .*stream solver"):
+                     modal=ModalPlateSettings(tail="ritz", tail_modes="auto"))  # fmt: skip
+    with pytest.raises(InputError, match=r"^plate\.tail_modes: 'auto' is the coupled solver's"):
         tb.simulate(inclined, progress=False)
 
 

@@ -57,6 +57,7 @@ def test_modal_keys_parsed():
         mesh_divisions=12,
         residual_flexibility=False,
         coupling="one-way",
+        tail_modes=32,  # the coupled solver's default, set by the scene
     )
     assert scene.sensors[0].bandwidth_hz == 5000.0
     assert loads_scene(dumps_scene(scene)) == scene

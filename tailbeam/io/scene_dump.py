@@ -40,7 +40,7 @@ def scene_to_dict(scene: Scene) -> dict:
             plate["mesh_divisions"] = m.mesh_divisions
         # always written: the default changed ("quasi-static" -> "auto") and a dumped scene
         # (a sweep case, impacts.json) must mean the same run whatever the default is
-        plate.update(tail=m.tail, tail_modes=m.tail_modes)
+        plate.update(tail=m.tail, tail_modes=m.tail_modes_for(scene.needs_stream_solver))
     used = {b.material for b in scene.balls} | {p.material}
     used |= {m for s in scene.streams for m in (s.coal_material, s.gangue_material)}
     materials = {

@@ -18,8 +18,8 @@ from tailbeam.progress import quiet
 
 def basis_signature(scene) -> str:
     """A key shared by the cases that use the same modal basis (plate, boundary, theory, mesh,
-    band): a sweep warms the cache once per key before its cases run; "" on the rigid
-    plate (no basis)."""
+    band; and a stream's tail basis): a sweep warms the cache once per key before its cases
+    run; "" on the rigid plate (no basis)."""
     if scene.plate_model != "modal":
         return ""
     m = scene.modal
@@ -34,6 +34,7 @@ def basis_signature(scene) -> str:
             m.theory,
             m.mesh_divisions,
             float(fmax),
+            scene.needs_stream_solver and m.tail == "ritz",  # the stream's tail basis too
         ]
     )
 
@@ -66,6 +67,10 @@ def warm_basis(scene_toml: str) -> str:
         band = stream_band(scene) if scene.needs_stream_solver else None
         with quiet():  # a worker's notes and bars would interleave on the user's terminal
             basis = build_basis(scene, band)
+            if band and scene.modal and scene.modal.tail == "ritz":  # the stream's tail basis
+                from tailbeam.solvers.stream.contact_tail import TAIL_BAND_FACTOR
+
+                build_basis(scene, {**band, "fmax_hz": TAIL_BAND_FACTOR * band["fmax_hz"]})
     except Exception as err:  # noqa: BLE001 - the cases then fail with their own error
         return f"basis not cached: {_one_line(err)}"
     return f"{basis.theory} {basis.boundary}, {basis.n_modes} modes"

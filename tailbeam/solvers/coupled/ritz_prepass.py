@@ -32,7 +32,7 @@ from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration
 from tailbeam.plate import ritz_tail
 from tailbeam.plate.ritz_tail import K_START, MAX_RITZ_VECTORS, choose_ritz_k, with_ritz_tail
 from tailbeam.progress import note, task
-from tailbeam.scene import DEFAULT_TAIL_MODES
+from tailbeam.scene import DEFAULT_TAIL_MODES, STREAM_TAIL_MODES
 
 AUTO_TOL = 1e-5  # choose_ritz_k's tolerance (relative to the max penetration)
 AUTO_RITZ_BUDGET = 128  # pseudo-modes (k x points) plate.tail = "auto" builds at most
@@ -166,14 +166,15 @@ def apply_tail(scene, basis, settings):
     the reason (said on stderr): a basis without an FE model (closed form), residual
     flexibility off, one-way coupling, more pseudo-modes than AUTO_RITZ_BUDGET (many
     balls) or than MAX_RITZ_VECTORS."""
+    tail_modes = settings.tail_modes_for(stream=False)
     if settings.tail == "ritz":
-        return ritz_tail_basis(scene, basis, settings.tail_modes)
+        return ritz_tail_basis(scene, basis, tail_modes)
     if settings.tail == "quasi-static":
         return basis, {"model": "quasi-static", "reason": "plate.tail"}
-    why = _why_not_ritz(settings, basis) or _over_budget(scene, basis, settings.tail_modes)
+    why = _why_not_ritz(settings, basis) or _over_budget(scene, basis, tail_modes)
     if why is None:
         try:
-            return ritz_tail_basis(scene, basis, settings.tail_modes)
+            return ritz_tail_basis(scene, basis, tail_modes)
         except WorkLimitError as err:
             why = str(err)
     note(f"tail: quasi-static ({why})")
@@ -218,20 +219,24 @@ def describe_tail(info: dict) -> str:
 
 
 def check_tail_scene(scene) -> None:
-    """Before any work: InputError naming plate.tail for scenes "ritz" cannot run (the stream
-    solver's), WorkLimitError naming plate.tail_modes if a set k x the first-contact points
-    exceeds MAX_RITZ_VECTORS."""
+    """Before any work: InputError naming plate.tail_modes for "auto" on the stream solver
+    (its contacts take a number of oscillators), WorkLimitError naming plate.tail_modes if a
+    set k x the first-contact points exceeds MAX_RITZ_VECTORS (the coupled solver)."""
     settings = scene.modal
     if settings is None or settings.tail != "ritz":
         return
     if scene.needs_stream_solver:
-        raise InputError(
-            "plate.tail",
-            "'ritz' is for the coupled modal solver; this scene runs on the stream solver "
-            "(streams, an inclined plate or balls that may touch); use 'quasi-static'",
-        )
-    if settings.tail_modes != "auto":
-        _check_work(settings.tail_modes, len(_unique(first_contacts(scene, "kirchhoff"))))
+        if settings.tail_modes == "auto":
+            raise InputError(
+                "plate.tail_modes",
+                "'auto' is the coupled solver's; on the stream solver (streams, an inclined "
+                "plate or balls that may touch) set a number of oscillators per contact "
+                f"(default {STREAM_TAIL_MODES})",
+            )
+        return
+    tail_modes = settings.tail_modes_for(stream=False)
+    if tail_modes != "auto":
+        _check_work(tail_modes, len(_unique(first_contacts(scene, "kirchhoff"))))
 
 
 def _check_work(k: int, n_points: int) -> None:

@@ -57,6 +57,9 @@ class ActiveMembers:
         self._phi_xy = {}  # plate pair key -> the point (x, y) of its mode shapes
         self._load_radii = {}  # ball -> radius (m) of its load model (contact_patch)
         self._x = {}  # state of members added since the last build
+        self._tails = {}  # plate pair key -> [TailModes, eta, eta'] (plate.tail = "ritz")
+        self._tail_cols = {}  # plate pair key -> its tail's columns in the built modal block
+        self.tail_energy_dropped = 0.0  # J: held by tails when their contacts ended
         self._v = {}
 
     # --- membership -----------------------------------------------------------------------------
@@ -69,6 +72,7 @@ class ActiveMembers:
         self.dirty = True
 
     def remove(self, i: int):
+        self._drop_tail((i, -1))
         self._sync()
         self.members.remove(i)
         self._x.pop(i, None)
@@ -85,7 +89,11 @@ class ActiveMembers:
         self._pairs = {k: self._pair_state(p) for k, p in self.index.items()}
         self._fresh = self._fresh_by_key()
         if self.plate is not None:  # each plate pair keeps its mode shapes (its contact point)
-            self._phi = {k: self.set.phi[p].copy() for k, p in self.index.items() if k[1] < 0}
+            n = self.plate.n_modes
+            self._phi = {k: self.set.phi[p, :n].copy() for k, p in self.index.items() if k[1] < 0}
+            for key, cols in self._tail_cols.items():
+                if key in self._tails:
+                    self._tails[key][1:] = [self.set.q[cols].copy(), self.set.qd[cols].copy()]
             self._cres = {k: self.set.law[p, L_CRES] for k, p in self.index.items() if k[1] < 0}
             self._phi_xy = {k: xy for k, xy in self._phi_xy.items() if k in self._phi}
 
@@ -167,11 +175,29 @@ class ActiveMembers:
                 self._x[i][2] = self._static_height(i, cres[q]) + phi[q] @ plate.q
         atol_x = self.rtol * 1e-3
         scale = float(np.max(plate.phi_max))
-        return dict(
-            omega=plate.omega, zeta=plate.zeta, q=plate.q, qd=plate.qd, phi=phi,
-            f_dead=plate.f_dead, atol_q=atol_x / scale, atol_qd=self.rtol / scale,
-            compliance=cres,
-        )  # fmt: skip
+        block = self._with_tails(phi)
+        return dict(**block, atol_q=atol_x / scale, atol_qd=self.rtol / scale, compliance=cres)
+
+    def _with_tails(self, phi) -> dict:
+        """The modal block: the plate's modes, then each touching plate pair's tail
+        oscillators (shapes only in that pair's row of phi; no dead loads)."""
+        plate = self.plate
+        parts = [(plate.omega, plate.zeta, plate.q, plate.qd)]
+        rows, self._tail_cols = [], {}
+        n = plate.n_modes
+        for key, (modes, eta, etad) in self._tails.items():
+            k = len(modes.nu)
+            self._tail_cols[key] = slice(n, n + k)
+            rows.append((self.keys.index(key), n, modes.b))
+            parts.append((modes.nu, modes.zeta, eta, etad))
+            n += k
+        full = np.zeros((phi.shape[0], n))
+        full[:, : plate.n_modes] = phi
+        for p, start, b in rows:
+            full[p, start : start + len(b)] = b
+        omega, zeta, q, qd = (np.concatenate(c) for c in zip(*parts, strict=True))
+        f_dead = np.concatenate([plate.f_dead, np.zeros(n - plate.n_modes)])
+        return dict(omega=omega, zeta=zeta, q=q, qd=qd, phi=full, f_dead=f_dead)
 
     def _static_height(self, i: int, cres: float) -> float:
         """Height (m) of ball i resting on the undeflected plate: its static penetration,
@@ -198,15 +224,21 @@ class ActiveMembers:
         if not free:
             return
         shapes, points = self._shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
+        moved = []
         for (_, i), shape, xy in zip(free, shapes, points, strict=True):
             p = self.index[(i, -1)]
             # only where the change of the plate under the ball cannot close its gap (a
-            # ball just off the plate keeps its shapes: no start or end out of nothing)
+            # ball just off the plate keeps its shapes: no start or end out of nothing); the
+            # change includes the deflection of the tail of its last contact, dropped with them
             gap = -s.penetration(p)[0]
-            if gap > abs((shape - s.phi[p]) @ s.q) + 1e-9:
-                s.set_phi(p, shape)
+            n = len(shape)
+            if gap > abs((shape - s.phi[p, :n]) @ s.q[:n] - s.phi[p, n:] @ s.q[n:]) + 1e-9:
+                s.set_phi(p, np.concatenate([shape, np.zeros(s.phi.shape[1] - n)]))
                 s.set_compliance(p, 0.0)  # (set when its contact starts)
                 self._phi_xy[(i, -1)] = xy
+                moved.append((i, -1))
+        for key in moved:  # (after the set's own changes: dropping syncs and rebuilds it)
+            self._drop_tail(key)
 
     def _compliance(self, key) -> float:
         """Residual compliance (m/N) of plate pair ``key`` at the point of its mode shapes."""
@@ -214,9 +246,50 @@ class ActiveMembers:
         return float(self.plate.compliance([self._phi_xy[key]], [self._load_radius(i)])[0])
 
     def _set_compliance(self, key):
-        """Modal plate: plate pair ``key`` (touching from now) gets its residual compliance."""
-        if self.plate is not None and key[1] < 0:
+        """Modal plate: plate pair ``key`` (touching from now) gets its tail (``_start_tail``)
+        or its residual compliance."""
+        if self.plate is not None and key[1] < 0 and not self._start_tail(key):
             self.set.set_compliance(self.index[key], self._compliance(key))
+
+    # --- dynamic tails (plate.tail = "ritz": tailbeam.solvers.stream.contact_tail) ---------------
+    def _start_tail(self, key) -> bool:
+        """Plate pair ``key`` (touching from now) gets the oscillators of its contact point, at
+        rest, and the spring of the modes above the tail's band; the set is rebuilt with them
+        before the next step. A pair that touches again at the same point (its shapes not
+        refreshed since) keeps its oscillators, still moving. False without a tail."""
+        if key in self._tails:
+            self.set.set_compliance(self.index[key], self._tails[key][0].compliance)
+            return True
+        tail = self.plate.tail_at(self._phi_xy[key], self._load_radius(key[0]))
+        if tail is None or not len(tail.nu):
+            return False
+        self.set.set_compliance(self.index[key], tail.compliance)
+        self._sync()
+        self._cres[key] = tail.compliance
+        self._tails[key] = [tail, np.zeros(len(tail.nu)), np.zeros(len(tail.nu))]
+        self.dirty = True
+        return True
+
+    def _drop_tail(self, key) -> None:
+        """Drop plate pair ``key``'s oscillators (its ball moved on to new shapes, was put at
+        rest or left; not when its contact ends: the plate under the ball would jump):
+        their energy goes to ``tail_energy_dropped``."""
+        if key not in self._tails:
+            return
+        self._sync()
+        self.tail_energy_dropped += self._tail_energy(key)
+        del self._tails[key]
+        self.dirty = True
+
+    def _tail_energy(self, key) -> float:
+        modes, eta, etad = self._tails[key]
+        return 0.5 * float(np.sum(etad**2 + (modes.nu * eta) ** 2))
+
+    def tail_energy(self) -> float:
+        """Energy (J) held by the tails of the contacts in progress."""
+        if self._tails:
+            self._sync()
+        return sum(self._tail_energy(key) for key in self._tails)
 
     def _shapes(self, balls, xy) -> tuple[np.ndarray, np.ndarray]:
         """Mode shapes (len, m) under ``balls`` at ``xy`` and the points (len, 2) they were
@@ -264,14 +337,16 @@ class ActiveMembers:
         self.h = s.h
         self._drain()
         if self.plate is not None:
-            self.plate.take(s.q, s.qd, out.t)
+            n = self.plate.n_modes
+            self.plate.take(s.q[:n], s.qd[:n], out.t)
         kind = _KIND.get(out.kind)
         if kind is None:
             return None, None, out.t
         if kind in ("start", "end"):
+            key = self.keys[out.index]
             if kind == "start":
-                self._set_compliance(self.keys[out.index])
-            return kind, self.keys[out.index], out.t
+                self._set_compliance(key)
+            return kind, key, out.t
         ball = self.members[out.index]
         return kind, (ball, EDGES[out.edge]) if kind == "leave" else ball, out.t
 
@@ -370,9 +445,13 @@ class ActiveMembers:
         removed = float(settle_excess(s.y, s.model(), p, q)) if s.touching[p] else 0.0
         if not s.touching[p]:  # a slow rebound: the energy of the normal motion above rest
             removed = 0.5 * s.mass[q] * s.v[q, 2] ** 2
-        w, wd = (s.phi[p] @ s.q, s.phi[p] @ s.qd) if self.plate is not None else (0.0, 0.0)
-        self._set_compliance((i, -1))
-        s.x[q, 2] = self._static_height(i, s.law[p, L_CRES]) + w
+        w, wd, cres = 0.0, 0.0, 0.0
+        if self.plate is not None:  # at rest: the static spring of the whole tail, no oscillators
+            n = self.plate.n_modes
+            w, wd = s.phi[p, :n] @ s.q[:n], s.phi[p, :n] @ s.qd[:n]
+            cres = self._compliance((i, -1))
+            s.set_compliance(p, cres)
+        s.x[q, 2] = self._static_height(i, cres) + w
         s.v[q, 2] = wd
         law = s.law[p]
         s.touching[p] = True
@@ -381,6 +460,7 @@ class ActiveMembers:
         s.settle_energy[q] = 0.0
         s.forget_fresh(p)
         self.quiet.add(i)
+        self._drop_tail((i, -1))
         return removed
 
     def wake(self, i: int):

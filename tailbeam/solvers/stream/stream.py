@@ -296,7 +296,10 @@ class _Stream(StreamHeap, StreamSetEvents, StreamMembership, StreamRecords):
         self.stats["energy_final"] = self._final_energy()
         if self.plate is not None:
             self.plate.propagate(self.duration)
-            self.stats["energy_plate_final"] = self.plate.energy()
+            # the tails of contacts still in progress are the plate's too (contact_tail)
+            self.stats["energy_plate_final"] = self.plate.energy() + self.act.tail_energy()
+            if self.plate.tail is not None:
+                self.stats["tail_energy_dropped"] = self.act.tail_energy_dropped
         for key in list(self.open):
             recs = self.open.pop(key)
             peak, t_peak, pen = self.act.accumulators(key)

@@ -17,7 +17,10 @@ Residual flexibility (``residual_flexibility``, the scene's ``plate.residual_fle
 default on as in the single-ball coupled solver): ``compliance`` gives the static compliance
 of the truncated modes at a contact point (``tailbeam.solvers.coupled.records.Compliance``: the full
 model's static compliance minus the kept modes' part, cached per basis and point), which the
-active set puts in series with the contact.
+active set puts in series with the contact. With a ``tail``
+(``tailbeam.solvers.stream.contact_tail``, ``plate.tail = "ritz"``) each contact gets a few
+oscillators for the modes above the band instead, and the spring only for those above the
+tail's wider band.
 """
 
 import numpy as np
@@ -34,14 +37,17 @@ class StreamPlate:
     """Modal state of the plate ``basis`` with damping ratios ``zeta`` (one per mode); with
     ``residual_flexibility`` the contacts get the truncated modes' static compliance."""
 
-    def __init__(self, basis, zeta, residual_flexibility=True):
+    def __init__(self, basis, zeta, residual_flexibility=True, tail=None):
         if residual_flexibility and basis.static_compliance_at is None:
             raise InputError(
                 "plate.residual_flexibility",
                 f"the {basis.theory} {basis.boundary} basis has no static compliance (a plate "
                 "with rigid-body modes); set residual_flexibility = false",
             )
+        if tail is not None and not residual_flexibility:
+            raise InputError("plate.tail", "'ritz' needs residual_flexibility = true")
         self.basis = basis
+        self.tail = tail  # a contact_tail.ContactTail, or None (the static spring alone)
         self.residual_flexibility = bool(residual_flexibility)
         self._compliance = Compliance(basis, self.residual_flexibility)
         self.omega = np.ascontiguousarray(basis.omega, dtype=float)
@@ -77,6 +83,13 @@ class StreamPlate:
         xy = np.atleast_2d(np.asarray(xy, dtype=float))
         return np.array([self._compliance(float(x), float(y), float(r))
                          for (x, y), r in zip(xy, np.ravel(radii), strict=True)])  # fmt: skip
+
+    def tail_at(self, xy, radius: float):
+        """The dynamic tail (``contact_tail.TailModes``) of a contact at xy (2,) m with load
+        radius ``radius`` m, or None without one."""
+        if self.tail is None:
+            return None
+        return self.tail.at(xy, radius, self.compliance([xy], [radius])[0])
 
     def set_dead_loads(self, xy, weights) -> None:
         """Dead loads from now on: weights (N, pressing down) at points xy (p, 2)."""
