@@ -104,10 +104,9 @@ def _through_stream(scene, how, reference: bool):
     from tailbeam.solvers.coupled.ritz_prepass import check_tail_scene
 
     check_tail_scene(scene)  # before any work
-    if scene.plate_model == "modal" and scene.modal and scene.modal.tail == "auto":
-        note("tail: quasi-static (the stream solver's default; plate.tail = 'ritz' gives each "
-             "contact a few oscillators for the modes above the band)")  # fmt: skip
     band = stream_band(scene) if scene.plate_model == "modal" else None
+    if band and band["tail_band_hz"] is None and scene.modal.tail != "quasi-static":
+        note(f"tail: quasi-static (plate.tail {scene.modal.tail}: {band['tail_reason']})")
     if band:  # (here, not in stream_band, which a sweep's client calls for every case)
         warning = check_stream_band(scene, band)
         if warning:
@@ -125,22 +124,28 @@ def check_stream_band(scene, band: dict) -> str | None:
     band is below what the shortest plate contact needs, else None."""
     from tailbeam.solvers.coupled.auto import stream_band_estimate
 
-    band.update(stream_band_estimate(scene, band["fmax_hz"], band["residual_flexibility"]))
+    # with the contact tail the contacts see the modes to its band (tailbeam.solvers.stream.
+    # contact_tail; its own error, measured <= 0.33 %, is not in the estimate)
+    seen = band.get("tail_band_hz") or band["fmax_hz"]
+    band.update(stream_band_estimate(scene, seen, band["residual_flexibility"]))
     if band.get("truncation_force_error", 0.0) > band["accuracy"]:
         return _band_warning(band)
     return None
 
 
 def _band_warning(band) -> str:
-    """One line: the stream's band is below what its shortest plate contact needs."""
+    """One line: the band the stream's contacts see (its modal band, or its contact tails')
+    is below what its shortest plate contact needs."""
     error = band["truncation_force_error"]
     estimate = (
         f"estimated error up to {error:.1%} (an upper estimate: measured 0.04-0.85 of it"
         if math.isfinite(error)
         else "the band stops below that contact's own frequency (no error estimate"
     )
+    tails = band.get("tail_band_hz")
+    tails = f", contact tails to {tails / 1e3:g} kHz" if tails else ""
     return (
-        f"modal band 0-{band['fmax_hz'] / 1e3:g} kHz ({band['reason']}): the shortest plate "
+        f"modal band 0-{band['fmax_hz'] / 1e3:g} kHz ({band['reason']}{tails}): the shortest plate "
         f"contacts ({band['hardest_contact']}, {band['contact_duration_min_s'] * 1e6:.0f} us) "
         f"would need {band['fmax_contact_hz'] / 1e3:.1f} kHz for a {band['accuracy']:.1%} peak "
         f"force; {estimate}; docs/streams.md, band and particle size)"
@@ -210,7 +215,7 @@ def stream_band(scene) -> dict:
     f_sensor = max((resolve(s).bandwidth_hz for s in scene.sensors), default=0.0)
     fmax = settings.fmax_hz or max(f_sensor, STREAM_MIN_BAND_HZ)
     two_way = settings.coupling == "two-way"
-    return {
+    return {**_stream_tail(settings, fmax, two_way),
         "fmax_hz": float(fmax), "user_fmax": settings.fmax_hz is not None,
         "reason": "plate.fmax" if settings.fmax_hz else "the sensors' bandwidth",
         "sensor_band_covered": bool(fmax >= f_sensor),
@@ -221,6 +226,29 @@ def stream_band(scene) -> dict:
             f"the contacts {'on' if settings.residual_flexibility else 'off'})" if two_way
             else "one-way (stream contacts on the rigid plate drive the modes)"
         ),
+    }  # fmt: skip
+
+
+def _stream_tail(settings, fmax: float, two_way: bool) -> dict:
+    """The stream's contact tail (plate.tail, tailbeam.solvers.stream.contact_tail): with
+    "ritz" or "auto" (the default), where it applies (two-way coupling, residual flexibility,
+    a band below TAIL_MAX_HZ / 1.5), k oscillators per contact for the modes up to
+    ``tail_band_hz`` (TAIL_BAND_FACTOR x the band, at most TAIL_MAX_HZ); else None: the
+    static spring alone, for ``tail_reason``."""
+    from tailbeam.solvers.stream.contact_tail import TAIL_BAND_FACTOR, TAIL_MAX_HZ
+
+    why = None
+    wide = min(TAIL_BAND_FACTOR * fmax, TAIL_MAX_HZ)
+    if settings.tail == "quasi-static":
+        why = "plate.tail"
+    elif not (two_way and settings.residual_flexibility):
+        why = "one-way coupling" if not two_way else "residual flexibility off"
+    elif wide < 1.5 * fmax:
+        why = f"the band is within 1.5x of {TAIL_MAX_HZ / 1e3:g} kHz, where contact tails stop"
+    k = settings.tail_modes_for(stream=True)
+    return {
+        "tail_band_hz": None if why else wide,
+        "tail_oscillators": 0 if why else int(k), "tail_reason": why or "",
     }  # fmt: skip
 
 
@@ -241,7 +269,7 @@ def _stream_plate(scene, band):
 
     basis, zeta = _basis_and_damping(scene, band)
     settings = scene.modal or ModalPlateSettings()
-    tail = _contact_tail(scene, band, basis) if settings.tail == "ritz" else None
+    tail = _contact_tail(scene, band, basis) if band["tail_band_hz"] else None
     return StreamPlate(basis, zeta, residual_flexibility=settings.residual_flexibility, tail=tail)
 
 
@@ -249,18 +277,17 @@ def _contact_tail(scene, band, basis):
     """The oscillators of a stream's contacts (tailbeam.solvers.stream.contact_tail), from a
     basis to TAIL_BAND_FACTOR x the band (computed once, cached)."""
     from tailbeam.solvers.coupled.solver import modal_damping
-    from tailbeam.solvers.stream.contact_tail import TAIL_BAND_FACTOR, ContactTail
+    from tailbeam.solvers.stream.contact_tail import ContactTail
 
     settings = scene.modal
-    wide_hz = TAIL_BAND_FACTOR * band["fmax_hz"]
-    wide = _tail_basis(scene, band, basis, wide_hz)
-    k = settings.tail_modes_for(stream=True)
+    wide_hz, k = band["tail_band_hz"], band["tail_oscillators"]
+    wide = tail_basis(scene, band, basis)
+    how = "plate.tail" if settings.tail == "ritz" else "plate.tail auto"
     note(
         f"tail: {k} oscillators at each plate contact for the modes between "
-        f"{band['fmax_hz'] / 1e3:g} and {wide_hz / 1e3:g} kHz ({wide.n_modes} modes, "
-        "plate.tail = 'ritz'), the static spring above"
+        f"{band['fmax_hz'] / 1e3:g} and {wide_hz / 1e3:g} kHz ({wide.n_modes - basis.n_modes} "
+        f"modes; {how}), a static spring for those above"
     )
-    band["tail"] = {"model": "ritz", "oscillators": int(k), "tail_band_hz": wide_hz}
 
     def damping(nu):
         return modal_damping(nu, settings.damping_ratio, settings.rayleigh)
@@ -268,13 +295,14 @@ def _contact_tail(scene, band, basis):
     return ContactTail(basis.omega, wide, k, damping)
 
 
-def _tail_basis(scene, band, basis, wide_hz):
-    """The basis of a stream's contact tails: to ``wide_hz`` on the band basis' own FE mesh
-    (its modes below the band are the band's; the mesh the wider band alone would choose is
-    ~5x larger and takes minutes), or a closed form to ``wide_hz``."""
+def tail_basis(scene, band, basis):
+    """The basis of a stream's contact tails: to band["tail_band_hz"] on the band basis' own
+    FE mesh (its modes below the band are the band's; the mesh the wider band alone would
+    choose is ~5x larger and takes minutes), or a closed form."""
     from tailbeam.plate import compute_modes
     from tailbeam.solvers.coupled.auto import build_basis
 
+    wide_hz = band["tail_band_hz"]
     if "divisions" not in basis.info:  # a closed form
         return build_basis(scene, {**band, "fmax_hz": wide_hz})
     return compute_modes(scene.plate, basis.boundary, theory=basis.info["theory"],

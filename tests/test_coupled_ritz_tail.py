@@ -249,13 +249,23 @@ def test_auto_tail_keeps_the_quasi_static_tail_where_ritz_does_not_apply(capsys,
 
 
 def test_auto_tail_on_the_stream_solver_runs(capsys):
-    # the stream solver keeps its own quasi-static residual: "auto" is accepted there, said
+    # "auto" on the stream solver: its contact tails (tests/test_stream_tail.py) where they
+    # apply, else the static spring, said
     ball = Ball("b", SANDSTONE, R, (*IMPACT, R + 1e-3), (0.0, 0.0, -1.0))
     inclined = Scene((ball,), Plate(), plate_model="modal", inclination=10.0, duration=2e-3,
                      modal=ModalPlateSettings(fmax_hz=2000.0))  # fmt: skip
     assert inclined.modal.tail == "auto"
-    assert len(tb.simulate(inclined).impacts) == 1
-    assert "tail: quasi-static (the stream solver" in capsys.readouterr().err
+    result = tb.simulate(inclined)
+    assert len(result.impacts) == 1 and result.info["band"]["tail_band_hz"] == 8000.0
+    assert "tail: 4 oscillators at each plate contact for the modes between 2 and 8 kHz" in (
+        capsys.readouterr().err
+    )
+    without = Scene((ball,), Plate(), plate_model="modal", inclination=10.0, duration=2e-3,
+                    modal=ModalPlateSettings(fmax_hz=2000.0, residual_flexibility=False))  # fmt: skip
+    assert tb.simulate(without).info["band"]["tail_band_hz"] is None
+    assert "tail: quasi-static (plate.tail auto: residual flexibility off)" in (
+        capsys.readouterr().err
+    )
 
 
 @pytest.mark.parametrize("tail", ["quasi-static", "ritz", "auto"])

@@ -30,6 +30,7 @@ penetration = 1e-4
 model = "modal"
 inclination = 20.0
 fmax = 3000.0
+tail = "quasi-static"  # the band check then has something to say (tails see to 12 kHz)
 [[streams]]
 name = "cave"
 rate = 40.0
@@ -154,3 +155,12 @@ def test_unknown_stream_axis_is_one_line(tmp_path, capsys):
     assert err.count("\n") == 1 and "Traceback" not in err
     assert 'axes."streams.main.gangue_fraction"' in err and "no entry named 'main'" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_stream_with_contact_tails_has_its_own_basis_signature():
+    from tailbeam.study.case import basis_signature
+
+    static = loads_scene(BASE)
+    tails = loads_scene(BASE.replace('tail = "quasi-static"', 'tail = "auto"'))
+    assert basis_signature(static) != basis_signature(tails)  # its warm-up builds both bases
+    assert "12000.0" in basis_signature(tails)

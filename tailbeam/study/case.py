@@ -34,7 +34,7 @@ def basis_signature(scene) -> str:
             m.theory,
             m.mesh_divisions,
             float(fmax),
-            scene.needs_stream_solver and m.tail == "ritz",  # the stream's tail basis too
+            _band(scene).get("tail_band_hz"),  # a stream's contact tails: their basis too
         ]
     )
 
@@ -57,7 +57,7 @@ def warm_basis(scene_toml: str) -> str:
     """Compute (or load) the modal basis of the scene into the on-disk cache; returns the
     basis description. Runs once per basis_signature before the sweep's cases."""
     from tailbeam.io.scene_file import loads_scene
-    from tailbeam.simulation import stream_band
+    from tailbeam.simulation import stream_band, tail_basis
     from tailbeam.solvers.coupled.auto import build_basis
 
     try:
@@ -67,10 +67,8 @@ def warm_basis(scene_toml: str) -> str:
         band = stream_band(scene) if scene.needs_stream_solver else None
         with quiet():  # a worker's notes and bars would interleave on the user's terminal
             basis = build_basis(scene, band)
-            if band and scene.modal and scene.modal.tail == "ritz":  # the stream's tail basis
-                from tailbeam.solvers.stream.contact_tail import TAIL_BAND_FACTOR
-
-                build_basis(scene, {**band, "fmax_hz": TAIL_BAND_FACTOR * band["fmax_hz"]})
+            if band and band["tail_band_hz"]:  # a stream's contact tails: their basis too
+                tail_basis(scene, band, basis)
     except Exception as err:  # noqa: BLE001 - the cases then fail with their own error
         return f"basis not cached: {_one_line(err)}"
     return f"{basis.theory} {basis.boundary}, {basis.n_modes} modes"

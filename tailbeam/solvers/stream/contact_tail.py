@@ -33,7 +33,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-TAIL_BAND_FACTOR = 4.0  # the wider basis' band, in units of the stream's band
+TAIL_BAND_FACTOR = 4.0  # the wider basis' band, in units of the stream's band ...
+TAIL_MAX_HZ = 40_000.0  # ... and at most this: contacts of lumps >= 10 mm need no more
+# dynamically (docs/streams.md); a wider basis costs minutes (~600 modes at 40 kHz on the
+# 10 kHz mesh: 25 s)
 BREAKDOWN = 1e-12  # a Lanczos vector this small against the first ends the rule early
 
 
