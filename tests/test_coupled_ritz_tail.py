@@ -260,8 +260,9 @@ def test_auto_tail_on_the_stream_solver_runs(capsys):
     assert "tail: 4 oscillators at each plate contact for the modes between 2 and 8 kHz" in (
         capsys.readouterr().err
     )
+    off = ModalPlateSettings(fmax_hz=2000.0, residual_flexibility=False)
     without = Scene((ball,), Plate(), plate_model="modal", inclination=10.0, duration=2e-3,
-                    modal=ModalPlateSettings(fmax_hz=2000.0, residual_flexibility=False))  # fmt: skip
+                    modal=off)  # fmt: skip
     assert tb.simulate(without).info["band"]["tail_band_hz"] is None
     assert "tail: quasi-static (plate.tail auto: residual flexibility off)" in (
         capsys.readouterr().err
