@@ -25,7 +25,7 @@ def basis_signature(scene) -> str:
     m = scene.modal
     p = scene.plate
     mat = p.material
-    fmax = _band(scene)["fmax_hz"]
+    band = _band(scene)
     return json.dumps(
         [
             [p.size_x, p.size_y, p.thickness],
@@ -33,8 +33,8 @@ def basis_signature(scene) -> str:
             m.boundary,
             m.theory,
             m.mesh_divisions,
-            float(fmax),
-            _band(scene).get("tail_band_hz"),  # a stream's contact tails: their basis too
+            float(band["fmax_hz"]),
+            band.get("tail_band_hz"),  # a stream's contact tails: their basis too
         ]
     )
 

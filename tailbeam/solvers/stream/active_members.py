@@ -30,6 +30,7 @@ from tailbeam.solvers.stream.active_pairs import (
     settle_excess,
 )
 from tailbeam.solvers.stream.active_set import ActiveSet, law_table
+from tailbeam.solvers.stream.active_tails import Tails
 
 SHAPE_REUSE = 2.5e-4  # m: mode shapes computed within this distance are reused (modal plate)
 _KIND = {"contact_start": "start", "contact_end": "end", "leave": "leave", "settle": "settle"}
@@ -57,9 +58,7 @@ class ActiveMembers:
         self._phi_xy = {}  # plate pair key -> the point (x, y) of its mode shapes
         self._load_radii = {}  # ball -> radius (m) of its load model (contact_patch)
         self._x = {}  # state of members added since the last build
-        self._tails = {}  # plate pair key -> [TailModes, eta, eta'] (plate.tail = "ritz")
-        self._tail_cols = {}  # plate pair key -> its tail's columns in the built modal block
-        self.tail_energy_dropped = 0.0  # J: held by tails when their contacts ended
+        self.tails = Tails()  # the plate pairs' contact tails (modal plate), by key
         self._v = {}
 
     # --- membership -----------------------------------------------------------------------------
@@ -91,9 +90,7 @@ class ActiveMembers:
         if self.plate is not None:  # each plate pair keeps its mode shapes (its contact point)
             n = self.plate.n_modes
             self._phi = {k: self.set.phi[p, :n].copy() for k, p in self.index.items() if k[1] < 0}
-            for key, cols in self._tail_cols.items():
-                if key in self._tails:
-                    self._tails[key][1:] = [self.set.q[cols].copy(), self.set.qd[cols].copy()]
+            self.tails.save(self.set.q, self.set.qd)
             self._cres = {k: self.set.law[p, L_CRES] for k, p in self.index.items() if k[1] < 0}
             self._phi_xy = {k: xy for k, xy in self._phi_xy.items() if k in self._phi}
 
@@ -175,29 +172,8 @@ class ActiveMembers:
                 self._x[i][2] = self._static_height(i, cres[q]) + phi[q] @ plate.q
         atol_x = self.rtol * 1e-3
         scale = float(np.max(plate.phi_max))
-        block = self._with_tails(phi)
+        block = self.tails.block(plate, phi, self.keys.index)
         return dict(**block, atol_q=atol_x / scale, atol_qd=self.rtol / scale, compliance=cres)
-
-    def _with_tails(self, phi) -> dict:
-        """The modal block: the plate's modes, then each touching plate pair's tail
-        oscillators (shapes only in that pair's row of phi; no dead loads)."""
-        plate = self.plate
-        parts = [(plate.omega, plate.zeta, plate.q, plate.qd)]
-        rows, self._tail_cols = [], {}
-        n = plate.n_modes
-        for key, (modes, eta, etad) in self._tails.items():
-            k = len(modes.nu)
-            self._tail_cols[key] = slice(n, n + k)
-            rows.append((self.keys.index(key), n, modes.b))
-            parts.append((modes.nu, modes.zeta, eta, etad))
-            n += k
-        full = np.zeros((phi.shape[0], n))
-        full[:, : plate.n_modes] = phi
-        for p, start, b in rows:
-            full[p, start : start + len(b)] = b
-        omega, zeta, q, qd = (np.concatenate(c) for c in zip(*parts, strict=True))
-        f_dead = np.concatenate([plate.f_dead, np.zeros(n - plate.n_modes)])
-        return dict(omega=omega, zeta=zeta, q=q, qd=qd, phi=full, f_dead=f_dead)
 
     def _static_height(self, i: int, cres: float) -> float:
         """Height (m) of ball i resting on the undeflected plate: its static penetration,
@@ -251,14 +227,14 @@ class ActiveMembers:
         if self.plate is not None and key[1] < 0 and not self._start_tail(key):
             self.set.set_compliance(self.index[key], self._compliance(key))
 
-    # --- dynamic tails (plate.tail = "ritz": tailbeam.solvers.stream.contact_tail) ---------------
+    # --- contact tails (tailbeam.solvers.stream.contact_tail, active_tails) -------------------
     def _start_tail(self, key) -> bool:
         """Plate pair ``key`` (touching from now) gets the oscillators of its contact point, at
         rest, and the spring of the modes above the tail's band; the set is rebuilt with them
         before the next step. A pair that touches again at the same point (its shapes not
         refreshed since) keeps its oscillators, still moving. False without a tail."""
-        if key in self._tails:
-            self.set.set_compliance(self.index[key], self._tails[key][0].compliance)
+        if key in self.tails:
+            self.set.set_compliance(self.index[key], self.tails.modes(key).compliance)
             return True
         tail = self.plate.tail_at(self._phi_xy[key], self._load_radius(key[0]))
         if tail is None or not len(tail.nu):
@@ -266,7 +242,7 @@ class ActiveMembers:
         self.set.set_compliance(self.index[key], tail.compliance)
         self._sync()
         self._cres[key] = tail.compliance
-        self._tails[key] = [tail, np.zeros(len(tail.nu)), np.zeros(len(tail.nu))]
+        self.tails.add(key, tail)
         self.dirty = True
         return True
 
@@ -274,22 +250,22 @@ class ActiveMembers:
         """Drop plate pair ``key``'s oscillators (its ball moved on to new shapes, was put at
         rest or left; not when its contact ends: the plate under the ball would jump):
         their energy goes to ``tail_energy_dropped``."""
-        if key not in self._tails:
+        if key not in self.tails:
             return
         self._sync()
-        self.tail_energy_dropped += self._tail_energy(key)
-        del self._tails[key]
+        self.tails.drop(key)
         self.dirty = True
 
-    def _tail_energy(self, key) -> float:
-        modes, eta, etad = self._tails[key]
-        return 0.5 * float(np.sum(etad**2 + (modes.nu * eta) ** 2))
+    @property
+    def tail_energy_dropped(self) -> float:
+        """Energy (J) the tails held when they were dropped."""
+        return self.tails.dropped
 
     def tail_energy(self) -> float:
         """Energy (J) held by the tails of the contacts in progress."""
-        if self._tails:
+        if self.tails.states:
             self._sync()
-        return sum(self._tail_energy(key) for key in self._tails)
+        return self.tails.energy()
 
     def _shapes(self, balls, xy) -> tuple[np.ndarray, np.ndarray]:
         """Mode shapes (len, m) under ``balls`` at ``xy`` and the points (len, 2) they were
