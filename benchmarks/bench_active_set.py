@@ -36,7 +36,7 @@ from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.solvers.rigid.model import make_pairs
 from tailbeam.solvers.rigid.solver import _KernelIntegrator
-from tailbeam.solvers.stream.active_set import ActiveSet
+from tailbeam.solvers.stream.active.set import ActiveSet
 
 RADIUS, SPEED = 0.03, 2.0
 

@@ -5,7 +5,7 @@ the residual flexibility costs.
 
 A sandstone ball (30 mm) strikes the 0.6 x 0.6 x 0.01 m simply supported steel plate at
 (0.07, -0.05) m at 2 m/s (c = 0, g = 9.81, modal damping 1 %); plate: the closed-form
-Kirchhoff modes (tailbeam.modal.ssss_kirchhoff_basis) truncated to m modes.
+Kirchhoff modes (tailbeam.plate.closed_forms.ssss_kirchhoff_basis) truncated to m modes.
 
 1. Cost per contact (START -> END, best of 3 x 20 contacts) against error, m = 0 (rigid
    plate), 25 and 100 modes, rtol 1e-8 / 1e-10 / 1e-12. Error: worst relative error of
@@ -31,12 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.materials import SANDSTONE
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.solvers.coupled import simulate_coupled
-from tailbeam.solvers.stream.active_set import ActiveSet
+from tailbeam.solvers.stream.active.set import ActiveSet
 
 RADIUS, SPEED, G, ZETA, XY = 0.03, 2.0, 9.81, 0.01, (0.07, -0.05)
 PLATE = Plate()

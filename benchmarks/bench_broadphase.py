@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.solvers.stream.broadphase import candidate_pairs, candidate_pairs_brute_force
+from tailbeam.solvers.stream.driver.broadphase import candidate_pairs, candidate_pairs_brute_force
 
 SOLIDS_FRACTION = 0.08
 HORIZON = 1e-3

@@ -30,13 +30,13 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from tailbeam.io.output import atomic_output_dir
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import STANDARD_GRAVITY as G
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import impact_force_array
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
-from tailbeam.scene import ContactSettings, SensorSpec
-from tailbeam.signals.sensor import anti_alias_fir, measure, resolve
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.scene import ContactSettings
+from tailbeam.signals.sensor import SensorSpec, anti_alias_fir, measure, resolve
 from tailbeam.solvers.coupled import simulate_coupled
 
 R = 0.03

@@ -42,7 +42,7 @@ def run_case(seed, duration, residual, carry, events_path, rtol=1e-10) -> dict:
 
     import tailbeam
     from tailbeam.io.scene_file import parse_scene
-    from tailbeam.solvers.stream import active_set
+    from tailbeam.solvers.stream.active import set as active_set
 
     active_set.CARRY_FRESH = carry
     data = base_scene(duration, [0.3, 0.8])

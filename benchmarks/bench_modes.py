@@ -5,7 +5,7 @@ Kirchhoff (Argyris) and Mindlin (Lagrange P4).
     python benchmarks/bench_modes.py --out DIR [--quick] [--fmax HZ]
 
 Writes DIR/bench_modes.csv, DIR/table.md and DIR/bench_modes.png. Also fits the error model
-err = C (k dx)^q used by tailbeam.plate.resolution (printed at the end of table.md).
+err = C (k dx)^q used by tailbeam.plate.fe.resolution (printed at the end of table.md).
 Run single-threaded BLAS for reproducible timings (OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1).
 """
 

@@ -11,7 +11,7 @@ Kirchhoff closed-form basis to 10 kHz (106 modes), 1 % damping, 2 sensors at 51.
 
 Rows:
 1. baseline, same run: a smaller stream (``duration`` 0.1 s, density as the full case) on
-   the sensor's fine grid (102.4 kHz) by the dense exact replay (tailbeam.solvers.coupled.forced:
+   the sensor's fine grid (102.4 kHz) by the dense exact replay (tailbeam.solvers.plate_loads.forced:
    one force column per contact, every node time) and by plate_response; wall time, the
    size of the dense force table, and their largest difference (both are exact, so it is
    rounding);
@@ -21,7 +21,7 @@ Rows:
    extra cost is one static deflection per distinct load point and sensor (this basis: the
    Navier double series, ~1 ms per point), reported separately;
 4. the full case through the whole sensor chain (sensor_outputs), wall time and peak memory;
-   its records are drawn in DIR/sensor_s1.png, sensor_s2.png (tailbeam.signals.sensor_figures).
+   its records are drawn in DIR/sensor_s1.png, sensor_s2.png (tailbeam.signals.figures).
 Rows 1-2 and 4 have the correction off.
 5. per-load-point costs with an FE Mindlin basis to 10 kHz (computed or cached by
    compute_modes, ~3 s): mode shapes and quasi-static correction for 2 000 random point
@@ -38,14 +38,14 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Plate
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.progress import quiet
-from tailbeam.scene import SensorSpec
-from tailbeam.signals.sensor_figures import sensor_figures
-from tailbeam.solvers.coupled.forced import forced_response
-from tailbeam.solvers.coupled.load_response import plate_response, sensor_outputs
-from tailbeam.solvers.coupled.loads import PlateLoads
+from tailbeam.signals.figures import sensor_figures
+from tailbeam.signals.sensor import SensorSpec
+from tailbeam.solvers.plate_loads.forced import forced_response
+from tailbeam.solvers.plate_loads.loads import PlateLoads
+from tailbeam.solvers.plate_loads.response import plate_response, sensor_outputs
 
 FMAX = 10000.0
 ZETA = 0.01
@@ -171,7 +171,7 @@ def fe_rows(quick):
     """Per-load-point costs with an FE Mindlin basis (10 kHz; quick: 5 kHz): mode shapes and
     the quasi-static correction for 2 000 random point loads and 1.5 mm Hertz discs."""
     from tailbeam.plate import compute_modes
-    from tailbeam.solvers.coupled.load_response import _residual, load_shapes
+    from tailbeam.solvers.plate_loads.response import _residual, load_shapes
 
     basis = compute_modes(Plate(), "SSSS", theory="mindlin", fmax_hz=5000.0 if quick else FMAX)
     rng = np.random.default_rng(2)

@@ -13,7 +13,7 @@ force, contact duration and rebound speed at 10 and 20 kHz relative to 40 kHz, b
 a-priori estimate the stream's band check gives at 10 kHz (tailbeam.solvers.coupled.auto:
 an upper estimate) and the band it would ask for. Beside them the 10 kHz band with the dynamic
 contact tail (``plate.tail = "ritz"``: 4 oscillators per contact for the modes from 10 to
-40 kHz, tailbeam.solvers.stream.contact_tail), against the 40 kHz basis and against a 40 kHz
+40 kHz, tailbeam.plate.contact_tail), against the 40 kHz basis and against a 40 kHz
 basis on the 10 kHz basis' own mesh (the tail is built on that mesh: this isolates the tail
 model from the meshes' difference, shown in the last column). Writes DIR/band_size.csv and
 DIR/table.md.

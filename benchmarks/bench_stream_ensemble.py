@@ -11,7 +11,7 @@ changes the RMS by 1 %. An ensemble can: the reference scene (examples/caving_st
 stream seeds 1..N, each at the band under test (``--band``, default 10 kHz) and at the top
 band (40 kHz, where the default leaves out the contact tails); the band under test with
 ``plate.tail = "quasi-static"``, or with ``--tail`` ``"ritz"`` (a few oscillators at every
-plate contact for the modes above the band, tailbeam.solvers.stream.contact_tail: the
+plate contact for the modes above the band, tailbeam.plate.contact_tail: the
 default below ~27 kHz); the paired relative
 difference of each sensor's RMS, its ensemble mean and standard error, and beside them the
 seed-to-seed spread of the RMS itself (what a recognition model sees from stream to stream).

@@ -22,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from stream_scenes import ten_ball_scene  # noqa: E402
 
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
-from tailbeam.solvers.stream.stream_reference import simulate_stream_reference  # noqa: E402
+from tailbeam.solvers.stream.reference.solver import simulate_stream_reference  # noqa: E402
 
 INCLINE = InclinedPlate(inclination=15.0)
 

@@ -8,7 +8,7 @@ modes below FMAX (1300 Hz: 11 modes; without --quick also 2600 Hz: 24 and 10 kHz
 the default band of the stream scenes), modal damping 1 %:
 horizontal with c = 0, and 15 degrees with c = 2000 N s/m, d = 2e-5 m (ramp, clamp).
 
-For each: the slow reference (tailbeam.solvers.stream.stream_reference) with exact mode shapes and
+For each: the slow reference (tailbeam.solvers.stream.reference.solver) with exact mode shapes and
 with frozen ones (a contact keeps the shapes of its first touch: the fast solver's model) at
 rtol 1e-12, and the frozen one at 1e-13 (the reference's own error); the fast solver
 (rtol 1e-12, no residual flexibility, no rest rules) at its defaults (shapes refreshed
@@ -38,13 +38,15 @@ sys.path.insert(0, str(HERE.parent / "tests"))
 from stream_scenes import modal_scene  # noqa: E402
 from test_stream_solver import _particles, _worst_difference  # noqa: E402
 
-from tailbeam.modal import ssss_kirchhoff_basis  # noqa: E402
 from tailbeam.physics.bodies import Plate  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
-from tailbeam.solvers.stream import active_members, stream, stream_membership  # noqa: E402
-from tailbeam.solvers.stream.reference_plate import ReferencePlate  # noqa: E402
-from tailbeam.solvers.stream.stream_plate import StreamPlate  # noqa: E402
-from tailbeam.solvers.stream.stream_reference import simulate_stream_reference  # noqa: E402
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.solvers.stream.active import members as active_members  # noqa: E402
+from tailbeam.solvers.stream.driver import loop as stream  # noqa: E402
+from tailbeam.solvers.stream.driver import membership as stream_membership  # noqa: E402
+from tailbeam.solvers.stream.plate import StreamPlate  # noqa: E402
+from tailbeam.solvers.stream.reference.plate import ReferencePlate  # noqa: E402
+from tailbeam.solvers.stream.reference.solver import simulate_stream_reference  # noqa: E402
 
 DURATION, ZETA = 0.03, 0.01
 SCENES = {

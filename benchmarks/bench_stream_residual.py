@@ -23,8 +23,8 @@ from tailbeam import SANDSTONE, Ball  # noqa: E402
 from tailbeam.io.scene_file import load_scene  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
 from tailbeam.simulation import _stream_plate, stream_band  # noqa: E402
-from tailbeam.solvers.stream.stream import solve_stream  # noqa: E402
-from tailbeam.solvers.stream.stream_plate import StreamPlate  # noqa: E402
+from tailbeam.solvers.stream.driver.loop import solve_stream  # noqa: E402
+from tailbeam.solvers.stream.plate import StreamPlate  # noqa: E402
 from tailbeam.streams.generator import Particle  # noqa: E402
 
 R = 0.03

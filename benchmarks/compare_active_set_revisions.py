@@ -77,16 +77,20 @@ def extract_revision(base, tmp: Path) -> Path:
     return old
 
 
-def import_either(path: str, before_layers: str):
-    """Module ``path`` of the tree on sys.path, or ``before_layers``, its path in a revision
-    before the layers move (issue 7: tailbeam.rigid -> tailbeam.solvers.rigid, ...), so that
-    a base on either side of the move runs the same code."""
-    try:
-        return importlib.import_module(path)
-    except ModuleNotFoundError as err:
-        if not path.startswith(err.name or "-"):
-            raise  # a dependency is missing, not the moved module
-        return importlib.import_module(before_layers)
+def from_either(name: str, *paths: str):
+    """Attribute ``name`` of the first module of ``paths`` that this tree has and that defines
+    it: a revision before or after a module moved (the restructure of 0.3.0 moved most of
+    them; ``tailbeam.solvers.rigid`` before that was ``tailbeam.rigid``) runs the same code."""
+    for path in paths:
+        try:
+            module = importlib.import_module(path)
+        except ModuleNotFoundError as err:
+            if not path.startswith(err.name or "-"):
+                raise  # a dependency is missing, not the moved module
+            continue
+        if hasattr(module, name):
+            return getattr(module, name)
+    raise ImportError(f"none of {paths} defines {name}")
 
 
 def main(base):

@@ -36,7 +36,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from compare_active_set_revisions import extract_revision, import_either
+from compare_active_set_revisions import extract_revision, from_either
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -86,26 +86,38 @@ def run_solvers(out_path, quick):
 
     import tailbeam
     from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_plate_law
-    from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.incline import InclinedPlate
+
+    ssss_kirchhoff_basis = from_either(
+        "ssss_kirchhoff_basis", "tailbeam.plate.closed_forms", "tailbeam.modal"
+    )
     from tailbeam.streams.generator import Particle
 
-    simulate_coupled = import_either(
-        "tailbeam.solvers.coupled", "tailbeam.coupled"
-    ).simulate_coupled
-    simulate_rigid = import_either("tailbeam.solvers.rigid", "tailbeam.rigid").simulate_rigid
-    simulate_rigid_reference = import_either(
-        "tailbeam.solvers.rigid.reference", "tailbeam.rigid.reference"
-    ).simulate_rigid_reference
-    solve_stream = import_either(
-        "tailbeam.solvers.stream.stream", "tailbeam.solvers.stream"
-    ).solve_stream
-    StreamPlate = import_either(
-        "tailbeam.solvers.stream.stream_plate", "tailbeam.solvers.stream_plate"
-    ).StreamPlate
-    simulate_stream_reference = import_either(
-        "tailbeam.solvers.stream.stream_reference", "tailbeam.solvers.stream_reference"
-    ).simulate_stream_reference
+    simulate_coupled = from_either(
+        "simulate_coupled", "tailbeam.solvers.coupled", "tailbeam.coupled"
+    )
+    simulate_rigid = from_either("simulate_rigid", "tailbeam.solvers.rigid", "tailbeam.rigid")
+    simulate_rigid_reference = from_either(
+        "simulate_rigid_reference", "tailbeam.solvers.rigid.reference", "tailbeam.rigid.reference"
+    )
+    solve_stream = from_either(
+        "solve_stream",
+        "tailbeam.solvers.stream.driver.loop",
+        "tailbeam.solvers.stream.stream",
+        "tailbeam.solvers.stream",
+    )
+    StreamPlate = from_either(
+        "StreamPlate",
+        "tailbeam.solvers.stream.plate",
+        "tailbeam.solvers.stream.stream_plate",
+        "tailbeam.solvers.stream_plate",
+    )
+    simulate_stream_reference = from_either(
+        "simulate_stream_reference",
+        "tailbeam.solvers.stream.reference.solver",
+        "tailbeam.solvers.stream.stream_reference",
+        "tailbeam.solvers.stream_reference",
+    )
 
     print(f"running {tailbeam.__file__}", flush=True)
     law = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0, penetration=1e-4)
@@ -126,9 +138,9 @@ def run_solvers(out_path, quick):
     if not quick:
         from tailbeam.plate import assemble_plate
 
-        fe_reference = import_either(
-            "tailbeam.solvers.coupled.fe_reference", "tailbeam.coupled.fe_reference"
-        ).fe_reference
+        fe_reference = from_either(
+            "fe_reference", "tailbeam.solvers.coupled.fe_reference", "tailbeam.coupled.fe_reference"
+        )
 
         model = assemble_plate(Plate(), "SSSS", theory="kirchhoff", divisions=8)
         fe = fe_reference(model, ball, slaw, 4e-4, dt=2e-7, sensors=[(0.05, 0.10)])

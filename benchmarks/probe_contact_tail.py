@@ -56,17 +56,17 @@ from scipy.special import sici
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_coupled_fe import IMPACT, MESHES, REF_DT, SENSOR, R, _basis, _case  # noqa: E402
 
-from tailbeam.modal import ModalBasis  # noqa: E402
 from tailbeam.physics.bodies import Ball, Plate  # noqa: E402
 from tailbeam.physics.contact_law import ball_plate_law  # noqa: E402
 from tailbeam.physics.materials import CARBON_STEEL, SANDSTONE  # noqa: E402
 from tailbeam.plate import assemble_plate, compute_modes, sparse_solve  # noqa: E402
+from tailbeam.plate.basis import ModalBasis  # noqa: E402
 from tailbeam.plate.ritz_tail import choose_ritz_k, ritz_tail_modes, with_ritz_tail  # noqa: E402
+from tailbeam.results.records import Impact  # noqa: E402
 from tailbeam.solvers.coupled.fe_compare import Case, modal_errors  # noqa: E402
 from tailbeam.solvers.coupled.fe_reference import impact_quantities  # noqa: E402
-from tailbeam.solvers.coupled.propagator import advance, coefficients  # noqa: E402
 from tailbeam.solvers.coupled.solver import simulate_coupled  # noqa: E402
-from tailbeam.solvers.records import Impact  # noqa: E402
+from tailbeam.solvers.plate_loads.propagator import advance, coefficients  # noqa: E402
 
 BANDS_HZ = (14e3, 20e3, 28e3)
 SHORT = {"restitution": "e", "peak_force": "F_max", "duration": "T", "max_penetration": "d_max"}

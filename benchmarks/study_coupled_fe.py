@@ -42,7 +42,7 @@ from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.hertz import hertz_max_penetration
 from tailbeam.physics.materials import CARBON_STEEL, SANDSTONE
 from tailbeam.plate import assemble_plate, compute_modes
-from tailbeam.plate.resolution import resolve
+from tailbeam.plate.fe.resolution import resolve
 from tailbeam.progress import quiet
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
 from tailbeam.solvers.coupled import records

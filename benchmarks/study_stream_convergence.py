@@ -7,7 +7,7 @@ stacked pair; tests/stream_scenes.py) on a horizontal and on a 20-degree plate, 
 stream of ~40 particles on the 20-degree plate (c = 300 N s/m). Plate: the closed-form SSSS
 Kirchhoff basis of the default 0.6 x 0.6 x 0.01 m steel plate (exact modes at any band, so
 the band study has no mesh error), 1 % modal damping, two-way coupling through the fast stream
-solver (``tailbeam.solvers.stream.stream.solve_stream`` with a ``StreamPlate``).
+solver (``tailbeam.solvers.stream.driver.loop.solve_stream`` with a ``StreamPlate``).
 
 1. Tolerance: rtol 1e-6 ... 1e-11 against rtol 1e-13, band fixed.
 2. Band: 2.5, 5, 10, 20 kHz against 40 kHz, rtol 1e-12, with the residual flexibility of the
@@ -39,11 +39,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from stream_scenes import first_impact_difference, ten_ball_scene  # noqa: E402
 
-from tailbeam.modal import ssss_kirchhoff_basis  # noqa: E402
 from tailbeam.physics.bodies import Plate  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
-from tailbeam.solvers.stream.stream import solve_stream  # noqa: E402
-from tailbeam.solvers.stream.stream_plate import StreamPlate  # noqa: E402
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.solvers.stream.driver.loop import solve_stream  # noqa: E402
+from tailbeam.solvers.stream.plate import StreamPlate  # noqa: E402
 from tailbeam.streams.generator import Particle, generate_particles  # noqa: E402
 
 DAMPING = 300.0  # N s/m, every contact

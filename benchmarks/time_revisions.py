@@ -26,7 +26,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from compare_active_set_revisions import extract_revision, import_either
+from compare_active_set_revisions import extract_revision, from_either
 
 ROOT = Path(__file__).resolve().parents[1]
 REPEATS = 40
@@ -54,7 +54,7 @@ def time_rigid(label):
     """Run and time the rigid scene (see the module's docstring); print one line."""
     from tailbeam import CARBON_STEEL, COAL, Ball, Plate, ball_plate_law
 
-    simulate_rigid = import_either("tailbeam.solvers.rigid", "tailbeam.rigid").simulate_rigid
+    simulate_rigid = from_either("simulate_rigid", "tailbeam.solvers.rigid", "tailbeam.rigid")
 
     law = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0, penetration=1e-4)
     balls = [Ball(f"b{i}", COAL, 0.03, (-0.2 + 0.04 * i, 0.0, 0.13 + 0.01 * i),
@@ -66,11 +66,14 @@ def time_rigid(label):
 def time_coupled(label):
     """Run and time the coupled scene (see the module's docstring); print one line."""
     from tailbeam import CARBON_STEEL, SANDSTONE, Ball, Plate, ball_plate_law
-    from tailbeam.modal import ssss_kirchhoff_basis
 
-    simulate_coupled = import_either(
-        "tailbeam.solvers.coupled", "tailbeam.coupled"
-    ).simulate_coupled
+    ssss_kirchhoff_basis = from_either(
+        "ssss_kirchhoff_basis", "tailbeam.plate.closed_forms", "tailbeam.modal"
+    )
+
+    simulate_coupled = from_either(
+        "simulate_coupled", "tailbeam.solvers.coupled", "tailbeam.coupled"
+    )
     basis = ssss_kirchhoff_basis(Plate(), 5000.0)
     ball = Ball("s", SANDSTONE, 0.03, (0.07, -0.05, 0.03 + 1e-4), (0.0, 0.0, -2.0))
     law = ball_plate_law(SANDSTONE, 0.03, CARBON_STEEL, damping=800.0)
@@ -85,9 +88,12 @@ def time_stream(label):
     from tailbeam.physics.incline import InclinedPlate
     from tailbeam.streams.generator import Particle
 
-    solve_stream = import_either(
-        "tailbeam.solvers.stream.stream", "tailbeam.solvers.stream"
-    ).solve_stream
+    solve_stream = from_either(
+        "solve_stream",
+        "tailbeam.solvers.stream.driver.loop",
+        "tailbeam.solvers.stream.stream",
+        "tailbeam.solvers.stream",
+    )
     incline = InclinedPlate(inclination=15.0)
     balls = stream_scenes.ten_ball_scene(incline)
     parts = [Particle(b.name, "", "coal", b.material, b.radius, b.mass, 0.0, tuple(b.position),

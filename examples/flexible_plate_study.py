@@ -24,12 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.paper.scenarios import SCENARIOS
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
-from tailbeam.scene import ContactSettings, SensorSpec
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.scene import ContactSettings
+from tailbeam.signals.sensor import SensorSpec
 from tailbeam.solvers.coupled import simulate_coupled
 from tailbeam.solvers.coupled.zener import point_impedance, zener_impact
 from tailbeam.solvers.rigid import simulate_rigid

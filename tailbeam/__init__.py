@@ -8,6 +8,7 @@ from tailbeam.cachedir import configure_numba_cache
 configure_numba_cache()  # before any module defines a cached numba kernel
 
 # the imports below come after the cache is configured
+from tailbeam._version import __version__  # noqa: E402
 from tailbeam.errors import InputError, WorkLimitError  # noqa: E402
 from tailbeam.io.scene_file import load_scene  # noqa: E402
 from tailbeam.physics.bodies import Ball, Plate  # noqa: E402
@@ -20,10 +21,11 @@ from tailbeam.physics.contact_law import (  # noqa: E402
 )
 from tailbeam.physics.contacts import PLATE, ContactTable  # noqa: E402
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE, Material, get_material  # noqa: E402
-from tailbeam.result import Result  # noqa: E402
+from tailbeam.results.result import Result  # noqa: E402
 from tailbeam.simulation import simulate  # noqa: E402
 
 __all__ = [
+    "__version__",
     "Ball",
     "Plate",
     "ImpactLaw",
@@ -44,5 +46,3 @@ __all__ = [
     "simulate",
     "Result",
 ]
-
-__version__ = "0.2.0"

@@ -62,18 +62,20 @@ def configure_numba_cache() -> Path:
     return folder
 
 
-# First-run compile time of each solver's kernels, measured on the 2-core machine (stop 15:
-# examples two_balls_rigid, modal_plate, small_stream with an empty cache, minus a cached run)
+# First-run compile time of each solver's kernels, measured on the 2-core machine (examples
+# two_balls_rigid, modal_plate, small_stream with an empty cache, minus a cached run)
 COMPILE_SECONDS = {"rigid": "~10 s", "coupled": "~30 s", "stream": "~25 s"}
+# The source folder of each solver's kernels (numba names its cache folders after it)
+KERNEL_FOLDERS = {"rigid": "rigid", "coupled": "coupled", "stream": "active"}
 
 
 def announce_first_compile(solver: str = "rigid") -> None:
     """Say so (tailbeam.progress.note) when numba's cache holds no compiled kernel of
-    ``solver`` (``"rigid"``, ``"coupled"`` or ``"stream"``, numba names its cache folders after the
-    source folder): the first run compiles them (COMPILE_SECONDS), later runs load them from the
-    cache."""
+    ``solver`` (``"rigid"``, ``"coupled"`` or ``"stream"``; numba names its cache folders after
+    the kernels' source folder, ``KERNEL_FOLDERS``): the first run compiles them
+    (COMPILE_SECONDS), later runs load them from the cache."""
     folder = Path(os.environ.get("NUMBA_CACHE_DIR") or numba_cache_dir())
-    if not any(folder.glob(f"{solver}*/*.nbi")):
+    if not any(folder.glob(f"{KERNEL_FOLDERS.get(solver, solver)}*/*.nbi")):
         from tailbeam.progress import note
 
         took = COMPILE_SECONDS.get(solver, "10-30 s")

@@ -16,8 +16,10 @@ from tailbeam.errors import (
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, Plate
 from tailbeam.physics.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
 from tailbeam.physics.contacts import PLATE, ContactTable
+from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import Material
-from tailbeam.signals.noise import NoiseSpec
+from tailbeam.signals.sensor import SensorSpec
+from tailbeam.streams.generator import Particle, particles_from_settings
 
 # Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams'
 # default penetration depth. c = 300 N s/m was chosen by running the paper's three scenarios over a
@@ -37,7 +39,7 @@ THEORIES = ("auto", "kirchhoff", "mindlin")
 COUPLINGS = ("two-way", "one-way")
 TAILS = ("auto", "quasi-static", "ritz")
 DEFAULT_TAIL_MODES = 32  # Ritz pseudo-modes per contact point (docs/fe-convergence.md)
-STREAM_TAIL_MODES = 4  # a stream contact's tail oscillators (tailbeam.solvers.stream.contact_tail)
+STREAM_TAIL_MODES = 4  # a stream contact's tail oscillators (tailbeam.plate.contact_tail)
 
 
 @dataclass(frozen=True)
@@ -82,7 +84,7 @@ class ModalPlateSettings:
     tail: how the truncated modes act at a contact: "quasi-static" (their static compliance),
     "ritz" (load-dependent Ritz pseudo-modes: on the coupled solver at the balls' first
     contact points, tailbeam.solvers.coupled.ritz_prepass; on the stream solver a few
-    oscillators at every plate contact, tailbeam.solvers.stream.contact_tail; needs
+    oscillators at every plate contact, tailbeam.plate.contact_tail; needs
     residual_flexibility and two-way coupling) or "auto" (the default: "ritz" where it
     applies, the coupled solver on an FE basis with both; "quasi-static" elsewhere, streams
     included, saying why).
@@ -156,43 +158,6 @@ class ModalPlateSettings:
                 "plate.tail",
                 "'ritz' refines the residual flexibility of two-way coupling; it needs "
                 "residual_flexibility = true and coupling = 'two-way'",
-            )
-
-
-@dataclass(frozen=True)
-class SensorSpec:
-    """An accelerometer on the plate, measuring acceleration normal to it (m/s^2).
-
-    position (x, y) in m; sample_rate in Hz; bandwidth_hz: upper edge of the usable band
-    (None: chosen from the sample rate); mounted_resonance_hz (None: chosen from the bandwidth).
-    """
-
-    name: str
-    position: tuple[float, float]
-    sample_rate: float = 51200.0
-    bandwidth_hz: float | None = None
-    mounted_resonance_hz: float | None = None
-    noise: NoiseSpec | None = None  # measurement noise added to the output (tailbeam.signals.noise)
-
-    def __post_init__(self):
-        field_ = f"sensors[{self.name}]"
-        object.__setattr__(self, "position", require_vector(f"{field_}.position", self.position, 2))
-        object.__setattr__(
-            self, "sample_rate", require_positive(f"{field_}.sample_rate", self.sample_rate)
-        )
-        if self.bandwidth_hz is not None:
-            bw = require_positive(f"{field_}.bandwidth", self.bandwidth_hz)
-            if bw >= 0.5 * self.sample_rate:
-                raise InputError(
-                    f"{field_}.bandwidth",
-                    f"must be below Nyquist, {0.5 * self.sample_rate:g} Hz, got {bw:g}",
-                )
-            object.__setattr__(self, "bandwidth_hz", bw)
-        if self.mounted_resonance_hz is not None:
-            object.__setattr__(
-                self,
-                "mounted_resonance_hz",
-                require_positive(f"{field_}.mounted_resonance", self.mounted_resonance_hz),
             )
 
 
@@ -295,8 +260,6 @@ class Scene:
     @property
     def incline(self):
         """The plate in its frame (tailbeam.physics.incline.InclinedPlate)."""
-        from tailbeam.physics.incline import InclinedPlate
-
         return InclinedPlate(self.plate, self.inclination, self.gravity)
 
     @functools.cached_property
@@ -305,8 +268,6 @@ class Scene:
         first (stream "", released at 0 s), then the streams' particles released before
         ``duration``, in release order. Stream particles are generated on first use
         (deterministic from the seeds)."""
-        from tailbeam.streams.generator import Particle, particles_from_settings
-
         out = [
             Particle(b.name, "", label, b.material, b.radius, b.mass, 0.0, b.position, b.velocity)
             for b, label in zip(self.balls, self.labels, strict=True)

@@ -1,7 +1,7 @@
 """``tailbeam.simulate(scene, **how)``: the one library call that runs a scene.
 
 What to simulate (a ``tailbeam.scene.Scene``) is positional; how (the solver, rtol,
-max_steps, progress) is keyword-only. It returns one result type, ``tailbeam.result.Result``,
+max_steps, progress) is keyword-only. It returns one result type, ``tailbeam.results.result.Result``,
 whichever solver runs. The solver is a swappable part (``solver=``, ``SOLVERS``):
 
 - ``"single-ball"``: the exact per-ball solvers, for scenes without streams, without
@@ -93,7 +93,7 @@ def choose_solver(scene, solver: str = "auto", field: str = "solver") -> str:
         raise InputError(
             field,
             "'stream-reference' runs on the rigid plate (plate.model = \"rigid\"); its modal "
-            "plate (tailbeam.solvers.stream.reference_plate) has no residual flexibility or "
+            "plate (tailbeam.solvers.stream.reference.plate) has no residual flexibility or "
             "sensors, and is used by the tests",
         )
     return solver
@@ -230,12 +230,12 @@ def stream_band(scene) -> dict:
 
 
 def _stream_tail(settings, fmax: float, two_way: bool) -> dict:
-    """The stream's contact tail (plate.tail, tailbeam.solvers.stream.contact_tail): with
+    """The stream's contact tail (plate.tail, tailbeam.plate.contact_tail): with
     "ritz" or "auto" (the default), where it applies (two-way coupling, residual flexibility,
     a band below TAIL_MAX_HZ / 1.5), k oscillators per contact for the modes up to
     ``tail_band_hz`` (TAIL_BAND_FACTOR x the band, at most TAIL_MAX_HZ); else None: the
     static spring alone, for ``tail_reason``."""
-    from tailbeam.solvers.stream.contact_tail import TAIL_BAND_FACTOR, TAIL_MAX_HZ
+    from tailbeam.plate.contact_tail import TAIL_BAND_FACTOR, TAIL_MAX_HZ
 
     why = None
     wide = min(TAIL_BAND_FACTOR * fmax, TAIL_MAX_HZ)
@@ -253,9 +253,9 @@ def _stream_tail(settings, fmax: float, two_way: bool) -> dict:
 
 
 def _basis_and_damping(scene, band):
+    from tailbeam.plate.basis import modal_damping
     from tailbeam.scene import ModalPlateSettings
     from tailbeam.solvers.coupled.auto import build_basis
-    from tailbeam.solvers.coupled.solver import modal_damping
 
     settings = scene.modal or ModalPlateSettings()
     basis = build_basis(scene, band)
@@ -263,9 +263,9 @@ def _basis_and_damping(scene, band):
 
 
 def _stream_plate(scene, band):
-    """The two-way modal plate of a stream scene (tailbeam.solvers.stream.stream_plate)."""
+    """The two-way modal plate of a stream scene (tailbeam.solvers.stream.plate)."""
     from tailbeam.scene import ModalPlateSettings
-    from tailbeam.solvers.stream.stream_plate import StreamPlate
+    from tailbeam.solvers.stream.plate import StreamPlate
 
     basis, zeta = _basis_and_damping(scene, band)
     settings = scene.modal or ModalPlateSettings()
@@ -274,10 +274,10 @@ def _stream_plate(scene, band):
 
 
 def _contact_tail(scene, band, basis):
-    """The oscillators of a stream's contacts (tailbeam.solvers.stream.contact_tail), from a
+    """The oscillators of a stream's contacts (tailbeam.plate.contact_tail), from a
     basis to TAIL_BAND_FACTOR x the band (computed once, cached)."""
-    from tailbeam.solvers.coupled.solver import modal_damping
-    from tailbeam.solvers.stream.contact_tail import ContactTail
+    from tailbeam.plate.basis import modal_damping
+    from tailbeam.plate.contact_tail import ContactTail
 
     settings = scene.modal
     wide_hz, k = band["tail_band_hz"], band["tail_oscillators"]
@@ -312,11 +312,11 @@ def tail_basis(scene, band, basis):
 def _modal_sensors(scene, result, band, plate):
     """The sensors of a stream on the modal plate: the stream's plate forces (two-way, or
     one-way from the rigid plate: ``result.loads``) drive the modes exactly; the sensors read
-    the plate there (tailbeam.solvers.coupled.load_response)."""
+    the plate there (tailbeam.solvers.plate_loads.response)."""
     from tailbeam.scene import ModalPlateSettings
     from tailbeam.solvers.coupled.auto import _choices
-    from tailbeam.solvers.coupled.load_response import sensor_outputs
-    from tailbeam.solvers.coupled.loads import PlateLoads
+    from tailbeam.solvers.plate_loads.loads import PlateLoads
+    from tailbeam.solvers.plate_loads.response import sensor_outputs
 
     settings = scene.modal or ModalPlateSettings()
     if plate is None:

@@ -1,7 +1,7 @@
 """A minimal driver for tests: every ball of a small scene in ONE active set, all pairs watched,
 restarted after every event; writes the same Impact / LeaveEvent records as the stream
 reference (not a test module; the fast solver's real driver is
-tailbeam/solvers/stream/stream.py)."""
+tailbeam/solvers/stream/driver/loop.py)."""
 
 import math
 
@@ -9,8 +9,8 @@ import numpy as np
 
 from tailbeam.physics.incline import EDGES
 from tailbeam.physics.pair import pair_kinematics, plate_foot
-from tailbeam.solvers.records import PLATE, Impact, LeaveEvent
-from tailbeam.solvers.stream.active_set import ActiveSet
+from tailbeam.results.records import PLATE, Impact, LeaveEvent
+from tailbeam.solvers.stream.active.set import ActiveSet
 
 
 def reference_pairs(n):

@@ -1,7 +1,7 @@
-"""The compiled active-set integrator (tailbeam.solvers.stream.active_set) against independent
+"""The compiled active-set integrator (tailbeam.solvers.stream.active.set) against independent
 truths: the rigid-plate solver (tailbeam.solvers.rigid, its own 1-D kernel), Johnson's Hertz closed
 forms (tailbeam.physics.hertz), conservation laws, the closed-form slide on the frictionless
-incline, and the slow scipy stream reference (tailbeam.solvers.stream.stream_reference) on the
+incline, and the slow scipy stream reference (tailbeam.solvers.stream.reference.solver) on the
 shared scenes.
 
 Tolerances are the brief's (1e-10 vs the rigid solver, 1e-8 Hertz, 1e-12 momentum, 1e-9
@@ -19,9 +19,10 @@ from numpy.polynomial import chebyshev as cheb
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_ball_law, ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.solvers.numerics import chebyshev as cheb_events
+from tailbeam.solvers.numerics import step_events
 from tailbeam.solvers.rigid import simulate_rigid
-from tailbeam.solvers.stream import cheb_events, step_events
-from tailbeam.solvers.stream.active_set import ActiveSet
+from tailbeam.solvers.stream.active.set import ActiveSet
 
 NO_GRAVITY = InclinedPlate(gravity=0.0)
 
@@ -232,7 +233,7 @@ def _scene_pair(name):
     after every event by the test driver) on a shared scene, rtol 1e-12 both."""
     from stream_scenes import leave_scene, ten_ball_scene
 
-    from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
+    from tailbeam.solvers.stream.reference.solver import simulate_stream_reference
 
     which, theta, damping, duration = SCENES[name]
     incline = InclinedPlate(inclination=theta)

@@ -1,10 +1,10 @@
 """The active set's two-way modal plate block against independent truths.
 
-Plate: the closed-form simply supported Kirchhoff modes below 5 kHz (tailbeam.modal, 52 modes
+Plate: the closed-form simply supported Kirchhoff modes below 5 kHz (tailbeam.plate.basis, 52 modes
 of the 0.6 x 0.6 x 0.01 m steel plate), so no FE solve is involved. Truths: the two-way
 coupled single-ball solver (tailbeam.solvers.coupled.simulate_coupled, an independent integrator:
 exact modal propagation under piecewise-linear forces, 2nd order in its step) without residual
-flexibility; the exact damped modal propagator (tailbeam.solvers.coupled.propagator); conservation
+flexibility; the exact damped modal propagator (tailbeam.solvers.plate_loads.propagator); conservation
 of energy. The rigid path (no modes) is checked bit for bit by the unchanged
 tests/test_active_set.py.
 """
@@ -13,12 +13,13 @@ import numpy as np
 import pytest
 
 from tailbeam.errors import InputError
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import ball_plate_law, elastic_energy
 from tailbeam.physics.materials import COAL, SANDSTONE
-from tailbeam.solvers.coupled import propagator, simulate_coupled
-from tailbeam.solvers.stream.active_set import ActiveSet
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.solvers.coupled import simulate_coupled
+from tailbeam.solvers.plate_loads import propagator
+from tailbeam.solvers.stream.active.set import ActiveSet
 
 R = 0.03
 G = 9.81

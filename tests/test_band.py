@@ -8,12 +8,11 @@ import pytest
 from tailbeam.cli import main
 from tailbeam.errors import InputError
 from tailbeam.io.scene_file import loads_scene
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
-from tailbeam.plate.closed_forms import ssss_static_compliance
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis, ssss_static_compliance
 from tailbeam.solvers.coupled import auto, simulate_coupled
 
 PLATE = Plate()

@@ -1,11 +1,11 @@
-"""Broad phase (tailbeam.solvers.stream.broadphase): the cell grid against brute force, and against
+"""Broad phase (tailbeam.solvers.stream.driver.broadphase): the cell grid against brute force, and against
 the actual closest approach of balls moving within their speed bounds (never a missed pair)."""
 
 import numpy as np
 import pytest
 
 from tailbeam.errors import InputError
-from tailbeam.solvers.stream.broadphase import candidate_pairs, candidate_pairs_brute_force
+from tailbeam.solvers.stream.driver.broadphase import candidate_pairs, candidate_pairs_brute_force
 
 
 def _scene(rng, n, side, r_max=0.04):

@@ -7,15 +7,15 @@ import pytest
 
 import tailbeam
 from tailbeam import COAL, SANDSTONE, Ball, InputError, Plate
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.contact_law import ImpactLaw, ball_plate_law
 from tailbeam.physics.contacts import PLATE, ContactTable, LawOptions, contact_table
 from tailbeam.physics.materials import CARBON_STEEL
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.scene import ContactSettings, Scene
 from tailbeam.solvers.coupled import simulate_coupled
 from tailbeam.solvers.rigid import simulate_rigid
 from tailbeam.solvers.stream.engine import run_reference
-from tailbeam.solvers.stream.stream import simulate_stream
+from tailbeam.solvers.stream.solver import simulate_stream
 
 SETTINGS = ContactSettings(exponent=1.5, damping=2000.0, penetration=2e-5, clamp=True)
 FIELDS = ("stiffness", "exponent", "damping", "penetration", "clamp")

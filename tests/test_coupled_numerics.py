@@ -10,14 +10,15 @@ from scipy.integrate import solve_ivp
 from scipy.sparse.linalg import splu
 
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.plate import assemble_plate, compute_modes
-from tailbeam.scene import SensorSpec
-from tailbeam.solvers.coupled import modal_damping, simulate_coupled
-from tailbeam.solvers.coupled.forced import forced_response
+from tailbeam.plate.basis import modal_damping
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.signals.sensor import SensorSpec
+from tailbeam.solvers.coupled import simulate_coupled
+from tailbeam.solvers.plate_loads.forced import forced_response
 
 R = 0.03
 LOAD, SENSOR = (0.07, -0.04), (-0.12, 0.15)

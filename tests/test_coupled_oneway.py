@@ -4,12 +4,13 @@ gets wrong; the scene runner and its band choice."""
 import numpy as np
 import pytest
 
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
-from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene, SensorSpec
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
+from tailbeam.signals.sensor import SensorSpec
 from tailbeam.solvers.coupled import choose_band, simulate_coupled, simulate_scene_modal
 from tailbeam.solvers.coupled.auto import BAND_ACCURACY
 from tailbeam.solvers.coupled.zener import point_impedance, zener_impact

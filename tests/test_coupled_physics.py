@@ -1,6 +1,6 @@
 """Two-way coupled ball / flexible-plate impacts against independent truths.
 
-Plate: the exact closed-form simply supported Kirchhoff modes (tailbeam.modal), so every
+Plate: the exact closed-form simply supported Kirchhoff modes (tailbeam.plate.basis), so every
 discrepancy below is the coupled solver's, not the plate model's.
 """
 
@@ -9,10 +9,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.scene import ContactSettings
 from tailbeam.solvers.coupled import simulate_coupled
 from tailbeam.solvers.coupled.zener import point_impedance, zener_impact

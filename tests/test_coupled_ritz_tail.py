@@ -11,9 +11,9 @@ from test_coupled_fe import IMPACT, MESHES, SENSOR, R, _basis, runs  # noqa: F40
 import tailbeam as tb
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.io.scene_file import dumps_scene, loads_scene, scene_to_dict
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.materials import SANDSTONE
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
 from tailbeam.solvers.coupled.auto import simulate_scene_modal
 from tailbeam.solvers.coupled.fe_compare import result_errors

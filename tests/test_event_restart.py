@@ -18,10 +18,10 @@ import pytest
 from tailbeam import CARBON_STEEL, COAL, Ball, ball_ball_law, ball_plate_law
 from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.solvers.stream.active_members import ActiveMembers
-from tailbeam.solvers.stream.active_pairs import R_CONTACT
-from tailbeam.solvers.stream.active_set import ActiveSet
-from tailbeam.solvers.stream.stream_state import Balls
+from tailbeam.solvers.stream.active.members import ActiveMembers
+from tailbeam.solvers.stream.active.pairs import R_CONTACT
+from tailbeam.solvers.stream.active.set import ActiveSet
+from tailbeam.solvers.stream.driver.balls import Balls
 from tailbeam.streams.generator import Particle
 
 R = 0.02  # m, every ball here
@@ -142,7 +142,7 @@ def _table(particles, incline):
 
 def test_set_fresh_keeps_at_most_the_kernel_capacity():
     """More markers than the kernel holds are cut to its capacity (MAX_FRESH), not an error."""
-    from tailbeam.solvers.stream.active_kernel import MAX_FRESH
+    from tailbeam.solvers.stream.active.kernel import MAX_FRESH
 
     s = _touching_pair(0.5 * BAND, T0, fresh=False)
     s.set_fresh(T0, [(R_CONTACT, 0)] * (MAX_FRESH + 3))

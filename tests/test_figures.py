@@ -16,8 +16,8 @@ from benchmarks.claim_map import QUICK
 from tailbeam.io.results_io import write_impacts_csv
 from tailbeam.paper import figures
 from tailbeam.paper.scenarios import SCENARIOS, run_scenario
+from tailbeam.signals.figures import build_sensor_figure, sensor_stats, welch_psd
 from tailbeam.signals.sensor import SensorChain, SensorOutput, amplitude_spectrum
-from tailbeam.signals.sensor_figures import build_sensor_figure, sensor_stats, welch_psd
 
 
 def render(fig):

@@ -1,11 +1,11 @@
-"""Closed-form motion between contacts (tailbeam.solvers.stream.flight) against closed forms."""
+"""Closed-form motion between contacts (tailbeam.solvers.numerics.flight) against closed forms."""
 
 import math
 
 import numpy as np
 import pytest
 
-from tailbeam.solvers.stream.flight import (
+from tailbeam.solvers.numerics.flight import (
     band_time,
     edge_time,
     first_crossing,

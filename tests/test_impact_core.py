@@ -16,7 +16,7 @@ import pytest
 from scipy.integrate import quad
 
 from tailbeam.physics import impact
-from tailbeam.solvers.records import EventKind
+from tailbeam.results.records import EventKind
 
 K, C, D = 3e9, 900.0, 1e-4
 EXPONENTS = (1.0, 1.5, 2.0, 2.2)

@@ -6,9 +6,8 @@ import pytest
 
 from tailbeam.errors import InputError
 from tailbeam.io.scene_file import dumps_scene, loads_scene
-from tailbeam.scene import SensorSpec
 from tailbeam.signals.noise import NoiseSpec, band_limited_noise, noise
-from tailbeam.signals.sensor import measure
+from tailbeam.signals.sensor import SensorSpec, measure
 
 FS = 20000.0
 N = 200_000

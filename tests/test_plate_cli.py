@@ -54,7 +54,7 @@ def test_default_output_is_frequencies_only(tmp_path, monkeypatch, capsys):
 
 def test_too_large_band_names_the_option_before_work(tmp_path, capsys):
     # fmax: the mesh the band needs is beyond the mesh limit; count: the estimated solve is
-    # far beyond the memory/time limits (tailbeam.plate.cost). Both refused before assembly.
+    # far beyond the memory/time limits (tailbeam.plate.fe.cost). Both refused before assembly.
     for option, value in (("--fmax", "1e6"), ("--fmax", "72000"), ("--count", "5000")):
         out = tmp_path / "out"
         code = main(["modes", option, value, "--no-cache", "--out", str(out)])

@@ -1,5 +1,5 @@
-"""Sparse load histories on the modal plate (tailbeam.solvers.coupled.loads / load_response) against
-independent truths: the dense exact replay (tailbeam.solvers.coupled.propagator), single-mode closed
+"""Sparse load histories on the modal plate (tailbeam.solvers.plate_loads.loads / load_response) against
+independent truths: the dense exact replay (tailbeam.solvers.plate_loads.propagator), single-mode closed
 forms, the Navier / Timoshenko static deflection, and the coupled result's own sensor path."""
 
 import tracemalloc
@@ -8,20 +8,20 @@ import numpy as np
 import pytest
 
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.materials import SANDSTONE
 from tailbeam.plate import compute_modes
-from tailbeam.scene import SensorSpec
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.signals.sensor import SensorSpec
 from tailbeam.solvers.coupled import CoupledResult
-from tailbeam.solvers.coupled.forced import forced_response
-from tailbeam.solvers.coupled.load_response import (
+from tailbeam.solvers.plate_loads.forced import forced_response
+from tailbeam.solvers.plate_loads.loads import PlateLoads
+from tailbeam.solvers.plate_loads.response import (
     load_shapes,
     plate_response,
     sensor_outputs,
     sensor_signals,
 )
-from tailbeam.solvers.coupled.loads import PlateLoads
 
 PLATE = Plate()
 DT = 2.0**-17  # s; dyadic, so grid times and their differences are exact
@@ -313,7 +313,7 @@ def test_quasi_static_on_an_fe_mindlin_basis_with_load_discs():
     # Mindlin FE basis (coarse mesh), loads spread over Hertz discs: the residual taken by
     # reciprocity (static solutions for unit loads at the points, disc-averaged at the loads)
     # equals the direct one (a static solution per load, ModalBasis.residual_cross_compliance)
-    from tailbeam.solvers.coupled.load_response import _residual
+    from tailbeam.solvers.plate_loads.response import _residual
 
     basis = compute_modes(PLATE, "SSSS", theory="mindlin", divisions=3, fmax_hz=3000.0)
     xyr = np.array([[0.1, -0.05, 0.002], [-0.2, 0.1, 0.0015], [0.1, -0.05, 0.002]])

@@ -13,7 +13,7 @@ from tailbeam.physics.materials import Material
 from tailbeam.plate import compute_modes, load_mesh, save_mesh, structured_mesh
 from tailbeam.plate.cache import cache_key
 from tailbeam.plate.closed_forms import levy_frequencies
-from tailbeam.plate.mesh import MESH_DIR, default_mesh_path
+from tailbeam.plate.fe.mesh import MESH_DIR, default_mesh_path
 
 PLATE = Plate()
 

@@ -11,7 +11,7 @@ import pytest
 from tailbeam.physics.bodies import Plate
 from tailbeam.plate import assemble_plate, compute_modes
 from tailbeam.plate.closed_forms import ssss_mode_count, ssss_modes
-from tailbeam.plate.sparse_solve import count_eigenvalues_below
+from tailbeam.plate.fe.sparse_solve import count_eigenvalues_below
 
 PLATE = Plate()
 

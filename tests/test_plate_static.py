@@ -3,10 +3,9 @@
 import numpy as np
 import pytest
 
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Plate
 from tailbeam.plate import assemble_plate, compute_modes
-from tailbeam.plate.closed_forms import ssss_static_compliance
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis, ssss_static_compliance
 
 PLATE = Plate()
 POINTS = np.array([[0.0, 0.0], [0.1, -0.15]])
@@ -24,7 +23,7 @@ def test_static_compliance_matches_navier_series(theory, radius):
 
 
 def test_navier_series_agrees_with_modal_module():
-    # the lead's independent Kirchhoff point-load series (tailbeam.modal)
+    # the lead's independent Kirchhoff point-load series (tailbeam.plate.basis)
     ref = ssss_kirchhoff_basis(PLATE, 1000.0).static_compliance_at(POINTS, 0.0)
     np.testing.assert_allclose(
         ssss_static_compliance(PLATE, POINTS, 0.0, "kirchhoff"), ref, rtol=1e-5

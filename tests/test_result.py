@@ -1,4 +1,4 @@
-"""One result type (tailbeam.result): the impacts.csv and particles.csv columns of [[balls]]
+"""One result type (tailbeam.results.result): the impacts.csv and particles.csv columns of [[balls]]
 scenes on the rigid and the modal plate.
 
 Independent truths: free fall (a ball dropped from rest at gap h strikes at t = sqrt(2 h / g)
@@ -21,7 +21,7 @@ from tailbeam.errors import InputError
 from tailbeam.io.scene_file import dumps_scene
 from tailbeam.physics.bodies import Ball
 from tailbeam.physics.materials import COAL, SANDSTONE
-from tailbeam.result import IMPACT_COLUMNS, IMPACT_TABLE_COLUMNS, PARTICLE_COLUMNS, Result
+from tailbeam.results.result import IMPACT_COLUMNS, IMPACT_TABLE_COLUMNS, PARTICLE_COLUMNS, Result
 from tailbeam.scene import ModalPlateSettings, Scene
 from tailbeam.solvers.stream.engine import stream_engine
 
@@ -83,7 +83,7 @@ def check_free_fall_columns(table, scene, contact_xy=None):
         assert (row["material"], row["radius"]) == (b.material.name, b.radius)
         assert row["label"] == labels[b.name]
         # on a plate row the pair's speeds are the ball's normal speeds (the stream solver's
-        # definition, tailbeam.solvers.records.ContactRecord)
+        # definition, tailbeam.results.records.ContactRecord)
         assert (row["approach_in"], row["approach_out"]) == (row["v_in"], row["v_out"])
         if contact_xy is not None:  # where the solver applied the contact force
             assert (row["x"], row["y"]) == pytest.approx(contact_xy[b.name], abs=1e-15)
@@ -209,10 +209,10 @@ def every_solver():
     """Rigid, rigid reference, two-way coupled, one-way, stream and stream reference on two
     balls: "c" dropped from rest, "m" moving sideways at 1 m/s from x = 0.25 m (it passes
     the x+ edge at 0.05 s). name -> result."""
-    from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.bodies import Plate
     from tailbeam.physics.contact_law import ball_plate_law
     from tailbeam.physics.materials import CARBON_STEEL
+    from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
     from tailbeam.solvers.coupled import simulate_coupled
     from tailbeam.solvers.coupled.oneway import simulate_one_way
     from tailbeam.solvers.rigid import simulate_rigid
@@ -244,7 +244,7 @@ def test_every_solver_records_the_one_event_record(every_solver):
     only the first ball's: the plate is at rest until then); "m" moves sideways at 1 m/s
     from x = 0.25 m and passes the x+ edge at 0.05 s.
     """
-    from tailbeam.solvers.records import PLATE, Event, EventKind
+    from tailbeam.results.records import PLATE, Event, EventKind
 
     gaps = TWO_GAPS
     _, results = every_solver
@@ -274,14 +274,14 @@ SINGLE_BALL = ("rigid", "rigid reference", "coupled two-way", "one-way")
 
 
 def test_every_solver_records_the_one_impact_record(every_solver):
-    """Every solver's ``impacts`` are ``tailbeam.solvers.records.Impact`` records (one class;
+    """Every solver's ``impacts`` are ``tailbeam.results.records.Impact`` records (one class;
     the old names are aliases of it), numbered 1, 2, ... per ball in time order. Independent
     truth: the lateral motion is uniform until a ball touches anything, so a single-ball
     solver's x, y (the ball centre's at t_start) are x0 + vx t_start, y0 + vy t_start for
     every contact, and so is every solver's first contact point of each ball (the contact
     point is under the centre on the horizontal plate)."""
+    from tailbeam.results.records import PLATE, ContactRecord, Impact
     from tailbeam.solvers.coupled.fe_reference import FEImpact
-    from tailbeam.solvers.records import PLATE, ContactRecord, Impact
     from tailbeam.solvers.rigid import Impact as RigidImpact
     from tailbeam.solvers.rigid.result import Impact as RigidResultImpact
 
@@ -308,8 +308,8 @@ def test_the_fe_reference_records_the_one_impact_record():
     from tailbeam.physics.contact_law import ball_plate_law
     from tailbeam.physics.materials import CARBON_STEEL
     from tailbeam.plate import assemble_plate
+    from tailbeam.results.records import PLATE, Impact
     from tailbeam.solvers.coupled.fe_reference import fe_reference
-    from tailbeam.solvers.records import PLATE, Impact
 
     gap, speed = 1e-4, 2.0
     ball = Ball("s", SANDSTONE, 0.03, (0.07, -0.05, 0.03 + gap), (0.0, 0.0, -speed))
@@ -333,7 +333,7 @@ def test_ball_ball_events_name_the_partner():
     both stream solvers record the contact's start, kinks and end as ``Event`` records of
     one ball with the other as partner; the start at the closed-form time 0.02 m / 2 m/s = 0.01 s
     (gravity moves both alike)."""
-    from tailbeam.solvers.records import Event, EventKind
+    from tailbeam.results.records import Event, EventKind
     from tailbeam.solvers.stream.engine import run_reference
 
     pair = (Ball("a", COAL, 0.02, (-0.03, 0.0, 0.2), (1.0, 0.0, 0.0)),

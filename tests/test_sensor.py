@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from tailbeam.errors import InputError
-from tailbeam.scene import SensorSpec
-from tailbeam.signals.sensor import amplitude_spectrum, chain_response, measure, resolve
+from tailbeam.signals.sensor import SensorSpec, amplitude_spectrum, chain_response, measure, resolve
 
 FS = 51200.0
 
@@ -87,10 +86,10 @@ def test_sensor_on_a_coupled_run_reads_the_plate_acceleration_in_band():
     # they agree to that gain (the chain neither delays nor distorts the band).
     from scipy import signal as sp_signal
 
-    from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.bodies import Ball, Plate
     from tailbeam.physics.contact_law import ball_plate_law
     from tailbeam.physics.materials import CARBON_STEEL, COAL
+    from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
     from tailbeam.solvers.coupled import simulate_coupled
 
     basis = ssss_kirchhoff_basis(Plate(), 10000.0)

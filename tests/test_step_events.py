@@ -1,10 +1,10 @@
-"""Events inside a step (tailbeam.solvers.stream.step_events) against closed-form roots."""
+"""Events inside a step (tailbeam.solvers.numerics.step_events) against closed-form roots."""
 
 import math
 
 import numpy as np
 
-from tailbeam.solvers.stream.step_events import (
+from tailbeam.solvers.numerics.step_events import (
     STEP_POINTS,
     certified_positive,
     chebyshev_coefficients,

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 from stream_scenes import first_impact_difference, ten_ball_scene
 
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Plate
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.solvers.stream.stream import solve_stream
-from tailbeam.solvers.stream.stream_plate import StreamPlate
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.solvers.stream.driver.loop import solve_stream
+from tailbeam.solvers.stream.plate import StreamPlate
 from tailbeam.streams.generator import Particle
 
 

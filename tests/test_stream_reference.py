@@ -1,4 +1,4 @@
-"""The slow stream reference (tailbeam.solvers.stream.stream_reference) against closed forms,
+"""The slow stream reference (tailbeam.solvers.stream.reference.solver) against closed forms,
 conservation laws and the rigid-plate solver.
 
 Tolerances: at rtol 1e-12 the reference reproduces the Hertz closed form to ~1e-12 and
@@ -15,9 +15,9 @@ from stream_scenes import static_penetration_on, ten_ball_scene
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_ball_law, ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.solvers.records import EventKind
+from tailbeam.results.records import EventKind
 from tailbeam.solvers.rigid.reference import simulate_rigid_reference
-from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
+from tailbeam.solvers.stream.reference.solver import simulate_stream_reference
 
 NO_GRAVITY = InclinedPlate(gravity=0.0)
 

@@ -1,4 +1,4 @@
-"""The slow stream reference on the two-way MODAL plate (tailbeam.solvers.stream.reference_plate)
+"""The slow stream reference on the two-way MODAL plate (tailbeam.solvers.stream.reference.plate)
 against independent truths, and the fast stream solver against it.
 
 - one ball on the closed-form SSSS plate: the two-way coupled single-ball solver without
@@ -21,14 +21,16 @@ from stream_scenes import modal_scene
 from test_stream_solver import _particles, _worst_difference
 
 from tailbeam import COAL, SANDSTONE, Ball, ball_plate_law
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Plate
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import CARBON_STEEL
-from tailbeam.solvers.stream import active_members, stream, stream_membership
-from tailbeam.solvers.stream.reference_plate import ReferencePlate
-from tailbeam.solvers.stream.stream_plate import StreamPlate
-from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.solvers.stream.active import members as active_members
+from tailbeam.solvers.stream.driver import loop as stream
+from tailbeam.solvers.stream.driver import membership as stream_membership
+from tailbeam.solvers.stream.plate import StreamPlate
+from tailbeam.solvers.stream.reference.plate import ReferencePlate
+from tailbeam.solvers.stream.reference.solver import simulate_stream_reference
 
 FMAX = 1300.0  # Hz: 11 modes of the SSSS plate (the reference's steps follow the top mode)
 ZETA = 0.01
@@ -215,9 +217,9 @@ def test_gap_rows_are_polynomial_to_round_off_with_exact_shapes(basis, monkeypat
     1.5e-14): what the certificate and root search rely on."""
     from numpy.polynomial import chebyshev as cheb
 
-    from tailbeam.solvers.records import EventKind
-    from tailbeam.solvers.stream import stream_reference as sr
-    from tailbeam.solvers.stream.step_events import STEP_POINTS, chebyshev_coefficients
+    from tailbeam.results.records import EventKind
+    from tailbeam.solvers.numerics.step_events import STEP_POINTS, chebyshev_coefficients
+    from tailbeam.solvers.stream.reference import solver as sr
 
     worst, detect = [], sr._Reference.detect
     u = np.linspace(-1.0, 1.0, 101)

@@ -17,9 +17,9 @@ from scipy.optimize import brentq
 from tailbeam import SANDSTONE, Ball, ball_plate_law
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import CARBON_STEEL
-from tailbeam.solvers.stream import active_pairs as ap
-from tailbeam.solvers.stream.stream import solve_stream
-from tailbeam.solvers.stream.stream_plate import StreamPlate
+from tailbeam.solvers.stream.active import pairs as ap
+from tailbeam.solvers.stream.driver.loop import solve_stream
+from tailbeam.solvers.stream.plate import StreamPlate
 from tailbeam.streams.generator import Particle
 
 R = 0.03
@@ -27,8 +27,8 @@ BALL = Ball("s", SANDSTONE, R, (0.07, -0.05, R + 1e-4), (0.0, 0.0, -2.0))
 
 
 def _ssss(fmax):
-    from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.bodies import Plate
+    from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 
     return ssss_kirchhoff_basis(Plate(), fmax)
 

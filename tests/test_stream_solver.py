@@ -1,6 +1,6 @@
-"""The fast stream solver (tailbeam.solvers.stream.stream) against independent truths.
+"""The fast stream solver (tailbeam.solvers.stream.driver.loop) against independent truths.
 
-- the slow reference (tailbeam.solvers.stream.stream_reference: scipy DOP853 over all balls, every
+- the slow reference (tailbeam.solvers.stream.reference.solver: scipy DOP853 over all balls, every
   pair watched) on scenes with ball-ball contacts, a 3-ball cluster, a stacked pair, the
   kinks of the damped law and balls leaving over the edges: every ContactRecord field within
   1e-6 (the issue's rigid-plate bound; measured <= 3.5e-8);
@@ -19,8 +19,8 @@ from stream_scenes import leave_scene, static_penetration_on, ten_ball_scene
 
 from tailbeam import COAL, SANDSTONE
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.solvers.stream.stream import solve_stream
-from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
+from tailbeam.solvers.stream.driver.loop import solve_stream
+from tailbeam.solvers.stream.reference.solver import simulate_stream_reference
 from tailbeam.streams.generator import Particle, generate_particles
 
 FIELDS = ("t_start", "t_end", "v_in", "v_out", "approach_in", "approach_out", "peak_force",
@@ -169,15 +169,15 @@ def test_dense_stream_finds_every_contact_on_time():
 
 def test_modal_plate_under_stream_loads_matches_the_one_way_solver():
     """Two balls (no ball-ball contact) on the closed-form SSSS plate: the stream solver's
-    plate loads through tailbeam.solvers.coupled.load_response = tailbeam.solvers.coupled's one-way
+    plate loads through tailbeam.solvers.plate_loads.response = tailbeam.solvers.coupled's one-way
     solver (the rigid solver + dense replay), at a sensor point over 20 ms."""
     from tailbeam import Ball, ball_plate_law
-    from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.bodies import Plate
     from tailbeam.physics.materials import CARBON_STEEL
-    from tailbeam.solvers.coupled.load_response import plate_response
-    from tailbeam.solvers.coupled.loads import PlateLoads
+    from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
     from tailbeam.solvers.coupled.oneway import simulate_one_way
+    from tailbeam.solvers.plate_loads.loads import PlateLoads
+    from tailbeam.solvers.plate_loads.response import plate_response
 
     basis = ssss_kirchhoff_basis(Plate(), 5000.0)
     balls = [Ball("a", COAL, 0.02, (0.05, 0.02, 0.03), (0.0, 0.0, -2.0)),
@@ -199,8 +199,8 @@ def test_modal_plate_under_stream_loads_matches_the_one_way_solver():
 
 
 def _ssss(fmax=5000.0):
-    from tailbeam.modal import ssss_kirchhoff_basis
     from tailbeam.physics.bodies import Plate
+    from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 
     return ssss_kirchhoff_basis(Plate(), fmax)
 
@@ -215,7 +215,7 @@ def test_two_way_single_ball_matches_the_coupled_solver(damping):
     from tailbeam import Ball, ball_plate_law
     from tailbeam.physics.materials import CARBON_STEEL
     from tailbeam.solvers.coupled import simulate_coupled
-    from tailbeam.solvers.stream.stream_plate import StreamPlate
+    from tailbeam.solvers.stream.plate import StreamPlate
 
     basis = _ssss()
     r = 0.03
@@ -245,7 +245,7 @@ def test_two_way_energy_is_conserved(residual):
     """c = 0 and undamped modes: the energy released is found in the balls that left, the
     balls at the end (their contacts' elastic energy with the residual spring's C F^2 / 2)
     and the plate's vibration (the modes took part in every contact)."""
-    from tailbeam.solvers.stream.stream_plate import StreamPlate
+    from tailbeam.solvers.stream.plate import StreamPlate
 
     basis = _ssss(3000.0)
     particles, incline = _stream(rate=100.0, stop=0.2, seed=2)

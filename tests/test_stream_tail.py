@@ -1,5 +1,5 @@
 """The stream solver's dynamic contact tail (``plate.tail = "ritz"``,
-tailbeam.solvers.stream.contact_tail), each check against an independent truth:
+tailbeam.plate.contact_tail), each check against an independent truth:
 
 - the Gauss rule keeps the 2k moments of the tail's measure (a closed sum), and is exact
   when the measure has no more points than oscillators;
@@ -16,12 +16,12 @@ import numpy as np
 import pytest
 
 from tailbeam import COAL, SANDSTONE
-from tailbeam.modal import ssss_kirchhoff_basis
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.solvers.stream.contact_tail import ContactTail, gauss_rule
-from tailbeam.solvers.stream.stream import solve_stream
-from tailbeam.solvers.stream.stream_plate import StreamPlate
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.plate.contact_tail import ContactTail, gauss_rule
+from tailbeam.solvers.stream.driver.loop import solve_stream
+from tailbeam.solvers.stream.plate import StreamPlate
 from tailbeam.streams.generator import Particle, generate_particles
 
 

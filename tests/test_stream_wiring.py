@@ -212,7 +212,7 @@ def test_simulate_refuses_what_it_cannot_run():
     ball = scene.balls[1]
     crowd = Scene((ball,), streams=scene.streams, duration=0.8)
     with pytest.MonkeyPatch.context() as mp:
-        import tailbeam.solvers.stream.stream as fast
+        import tailbeam.solvers.stream.solver as fast
 
         mp.setattr(fast, "MAX_PARTICLES", 5)
         with pytest.raises(WorkLimitError, match=r"^streams\[1\].rate: .*at most 5"):
@@ -430,25 +430,3 @@ def test_simulate_bounds_the_stream_work():
     modal = load_scene(ROOT / "examples" / "modal_plate.toml")
     with pytest.raises(InputError, match="rtol: is not a setting of the modal"):
         tailbeam.simulate(modal, rtol=1e-8, progress=False)
-
-
-def test_the_fast_solver_plugs_in_by_existing(monkeypatch):
-    """A module tailbeam.solvers.stream.stream with simulate_stream replaces the reference with no
-    other change (the lead's one-line swap), called with the scene's particles and laws."""
-    import types
-
-    from tailbeam.solvers.stream.engine import stream_engine
-
-    calls = []
-    fake = types.ModuleType("tailbeam.solvers.stream.stream")
-    fast_result = types.SimpleNamespace(info={})  # tailbeam.simulate writes info["solver_choice"]
-    fake.simulate_stream = lambda *args, **kw: calls.append((args, kw)) or fast_result
-    fake.MAX_PARTICLES = 10**6
-    monkeypatch.setitem(sys.modules, "tailbeam.solvers.stream.stream", fake)
-    assert stream_engine().name == "fast stream solver"
-    scene = load_scene(SMALL)
-    assert tailbeam.simulate(scene, progress=False) is fast_result
-    ((args, kw),) = calls
-    assert args[0] == scene.particles and args[2] == scene.duration
-    assert kw["laws"] is scene.contacts() and args[1] == scene.incline  # the contact table
-    assert kw["laws"].options == LawOptions.of(scene.contact)

@@ -12,7 +12,7 @@ pytest.importorskip("zarr")
 
 import xarray as xr  # noqa: E402
 
-from tailbeam.commands.simulate import solve  # noqa: E402
+from tailbeam.cli.simulate import solve  # noqa: E402
 from tailbeam.errors import InputError  # noqa: E402
 from tailbeam.io.scene_file import loads_scene  # noqa: E402
 from tailbeam.study import dataset  # noqa: E402

@@ -44,7 +44,7 @@ def check_output_dir(out_dir, *, field: str = "--out") -> Path:
 
 def _write_manifest(folder: Path, command: str, files: dict) -> None:
     listed = sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
-    from tailbeam import __version__
+    from tailbeam._version import __version__
 
     manifest = {
         "tailbeam_version": __version__,

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 # Column order of impacts.csv (the contract's first twelve columns, then the rest) and units.
-from tailbeam.result import (  # noqa: F401 - IMPACT_COLUMNS: imported from here by callers
+from tailbeam.results.result import (  # noqa: F401 - IMPACT_COLUMNS: imported from here by callers
     IMPACT_COLUMNS,
     IMPACT_TABLE_UNITS,
     IMPACT_UNITS,
@@ -60,7 +60,7 @@ def write_table_csv(path, table: dict, units: dict) -> Path:
 
 def write_result_tables(out_dir, result, scene_echo: dict | None = None) -> list:
     """impacts.csv (every column of ``result.impacts_table()``), particles.csv and
-    impacts.json of any ``tailbeam.result.Result`` into the folder ``out_dir``."""
+    impacts.json of any ``tailbeam.results.result.Result`` into the folder ``out_dir``."""
     out_dir = Path(out_dir)
     return [
         write_table_csv(out_dir / "impacts.csv", result.impacts_table(), IMPACT_TABLE_UNITS),

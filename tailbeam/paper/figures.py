@@ -14,7 +14,7 @@ from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from tailbeam.signals.sensor_figures import sensor_figure, sensor_figures  # noqa: F401 (re-exported)
+from tailbeam.signals.figures import sensor_figure, sensor_figures  # noqa: F401 (re-exported)
 
 # The paper's figure numbers: (position, velocity, force) per scenario.
 PAPER_FIGURES = {"velocity": (2, 3, 4), "material": (5, 6, 7), "energy": (8, 9, 10)}

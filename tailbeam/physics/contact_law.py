@@ -23,6 +23,10 @@ from tailbeam.physics import impact
 from tailbeam.physics.materials import Material, effective_modulus
 
 HERTZ_EXPONENT = 1.5
+# The law's parameters as the compiled kernels take them: one row [k, e, c, d, clamp] per law
+# (``law_table``); a solver keeps its own per-law values in the columns after LAW_COLUMNS.
+LAW_K, LAW_E, LAW_C, LAW_D, LAW_CLAMP = range(5)
+LAW_COLUMNS = 5
 
 
 @dataclass(frozen=True)
@@ -178,6 +182,14 @@ def clamp_indicator(delta: float, delta_dot: float, law: ImpactLaw, ramp: bool) 
 def elastic_energy(delta, law: ImpactLaw):
     """Energy in J stored by the elastic term: k delta^(e+1) / (e+1) for delta > 0, else 0."""
     return _elastic_energy(_floats(delta), law.stiffness, law.exponent)
+
+
+def law_table(laws) -> np.ndarray:
+    """(P, LAW_COLUMNS) array of the ``ImpactLaw``s ``laws``: k, e, c, d, clamp (0 or 1)."""
+    return np.array(
+        [[w.stiffness, w.exponent, w.damping, w.penetration, float(w.clamp)] for w in laws],
+        dtype=float,
+    ).reshape(-1, LAW_COLUMNS)
 
 
 def _parameters(law):

@@ -5,10 +5,10 @@ closed forms and published tables, with automatic theory/mesh choice and a disk 
     from tailbeam.plate import compute_modes, PlateModel, assemble_plate
 """
 
-from tailbeam.plate.boundary import parse_boundary, rigid_body_mode_count
-from tailbeam.plate.mesh import load_mesh, save_mesh, structured_mesh
-from tailbeam.plate.model import PlateModel, assemble_plate
-from tailbeam.plate.modes import FEModalBasis, compute_modes
+from tailbeam.plate.fe.boundary import parse_boundary, rigid_body_mode_count
+from tailbeam.plate.fe.mesh import load_mesh, save_mesh, structured_mesh
+from tailbeam.plate.fe.model import PlateModel, assemble_plate
+from tailbeam.plate.fe.modes import FEModalBasis, compute_modes
 
 __all__ = [
     "compute_modes",

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from skfem import MeshTri
 
-from tailbeam import __version__
+from tailbeam._version import __version__
 from tailbeam.cachedir import cache_root
 from tailbeam.physics.bodies import Plate
 from tailbeam.plate.closed_forms import SHEAR_COEFFICIENT

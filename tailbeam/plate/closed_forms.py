@@ -1,8 +1,9 @@
 """Closed-form and tabulated plate frequencies: the independent truths the FE models are checked
 against, and the estimates the automatic theory/mesh choice is based on.
 
-- Simply supported (SSSS) Kirchhoff: f_mn = (pi/2)(m^2/a^2 + n^2/b^2) sqrt(D/(rho h)) (reused
-  from ``tailbeam.modal``).
+- Simply supported (SSSS) Kirchhoff: f_mn = (pi/2)(m^2/a^2 + n^2/b^2) sqrt(D/(rho h)), and
+  the exact modal basis of that plate (``ssss_kirchhoff_basis``, with the Navier series of its
+  static compliance).
 - SSSS Reissner-Mindlin (shear coefficient kappa = 5/6, rotary inertia rho h^3/12): the modes
   are the same sin*sin shapes; the flexural frequency of each (m, n) is the lower root of
       rho h I omega^4 - omega^2 (S I k^2 + rho h D k^2 + rho h S) + S D k^4 = 0,
@@ -16,10 +17,92 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tailbeam.modal import ssss_kirchhoff_frequencies
+from tailbeam.errors import InputError
 from tailbeam.physics.bodies import Plate
+from tailbeam.plate.basis import ModalBasis
 
 SHEAR_COEFFICIENT = 5.0 / 6.0  # Reissner's value for a homogeneous plate
+NAVIER_TERMS = 2000  # per direction
+NAVIER_CHUNK = 256  # points per matrix product of the Navier series
+
+
+def ssss_kirchhoff_frequencies(plate: Plate, m, n) -> np.ndarray:
+    """Closed form f_mn = (pi/2)(m^2/a^2 + n^2/b^2) sqrt(D/(rho h)) in Hz (simply supported)."""
+    m = np.asarray(m, dtype=float)
+    n = np.asarray(n, dtype=float)
+    a, b = plate.size_x, plate.size_y
+    return (
+        0.5
+        * np.pi
+        * (m**2 / a**2 + n**2 / b**2)
+        * np.sqrt(plate.bending_stiffness / plate.mass_per_area)
+    )
+
+
+def ssss_kirchhoff_basis(plate: Plate, fmax_hz: float) -> ModalBasis:
+    """Exact Kirchhoff modes of the simply supported plate below ``fmax_hz``.
+
+    phi_mn = 2/sqrt(rho h a b) sin(m pi (x + a/2)/a) sin(n pi (y + b/2)/b).
+    The static compliance and cross compliance (point loads, the Kirchhoff load model) are
+    the Navier double series, summed to 1e-6 relative.
+    """
+    a, b = plate.size_x, plate.size_y
+    f1 = ssss_kirchhoff_frequencies(plate, 1, 1)
+    if fmax_hz < f1:
+        raise InputError("fmax_hz", f"no mode below {fmax_hz!r} Hz; the first is {f1:.4g} Hz")
+    m_max = int(np.ceil(np.sqrt(fmax_hz / ssss_kirchhoff_frequencies(plate, 1, 0)))) + 1
+    n_max = int(np.ceil(np.sqrt(fmax_hz / ssss_kirchhoff_frequencies(plate, 0, 1)))) + 1
+    mm, nn = np.meshgrid(np.arange(1, m_max + 1), np.arange(1, n_max + 1), indexing="ij")
+    freqs = ssss_kirchhoff_frequencies(plate, mm, nn).ravel()
+    order = np.argsort(freqs, kind="stable")
+    keep = order[freqs[order] <= fmax_hz]
+    m_idx, n_idx, freqs = mm.ravel()[keep], nn.ravel()[keep], freqs[keep]
+    amp = 2.0 / np.sqrt(plate.mass_per_area * a * b)
+
+    def deflection_at(points: np.ndarray) -> np.ndarray:
+        x = points[:, 0:1] + 0.5 * a
+        y = points[:, 1:2] + 0.5 * b
+        return amp * np.sin(m_idx * np.pi * x / a) * np.sin(n_idx * np.pi * y / b)
+
+    def navier(load_point, points):
+        # Navier series at points (p, 2); terms fall like 1/(m^2 + n^2)^2, so the tail beyond
+        # N is O(1/N^2). Summed as a matrix product, NAVIER_CHUNK points at a time.
+        k = np.arange(1, NAVIER_TERMS + 1)
+        inv_denom = 1.0 / (k[:, None] ** 2 / a**2 + k[None, :] ** 2 / b**2) ** 2
+        lx = np.sin(k * np.pi * (load_point[0] + 0.5 * a) / a)
+        ly = np.sin(k * np.pi * (load_point[1] + 0.5 * b) / b)
+        out = np.empty(len(points))
+        for s in range(0, len(points), NAVIER_CHUNK):
+            chunk = points[s : s + NAVIER_CHUNK]
+            sx = np.sin(k * np.pi * (chunk[:, 0:1] + 0.5 * a) / a) * lx
+            sy = np.sin(k * np.pi * (chunk[:, 1:2] + 0.5 * b) / b) * ly
+            out[s : s + NAVIER_CHUNK] = np.sum(sx * (sy @ inv_denom.T), axis=1)
+        return 4.0 / (a * b * plate.bending_stiffness * np.pi**4) * out
+
+    def point_load_only(contact_radius):
+        if contact_radius != 0.0:
+            raise InputError("contact_radius", "the closed-form Kirchhoff basis takes point loads")
+
+    def static_compliance_at(points: np.ndarray, contact_radius: float = 0.0) -> np.ndarray:
+        point_load_only(contact_radius)
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        return np.array([navier(p, p[None, :])[0] for p in points])
+
+    def static_deflection_at(load_point, points, contact_radius: float = 0.0) -> np.ndarray:
+        point_load_only(contact_radius)
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        return navier(np.asarray(load_point, dtype=float).reshape(2), points)
+
+    return ModalBasis(
+        plate=plate,
+        frequencies_hz=freqs,
+        deflection_at=deflection_at,
+        theory="kirchhoff-closed-form",
+        boundary="SSSS",
+        static_compliance_at=static_compliance_at,
+        static_deflection_at=static_deflection_at,
+        info={"m": m_idx, "n": n_idx},
+    )
 
 
 def _mindlin_constants(plate: Plate):

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam.modal import ModalBasis
-from tailbeam.plate.boundary import CONDITIONS, EDGES
+from tailbeam.plate.basis import ModalBasis
+from tailbeam.plate.fe.boundary import CONDITIONS, EDGES
 from tailbeam.plate.mode_labels import label_modes
 
 VTU_REFINE = 2  # each triangle split into 4^2 for a smooth picture of the quintic shapes

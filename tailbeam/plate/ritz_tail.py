@@ -23,8 +23,8 @@ import numpy as np
 from scipy.linalg import eigh
 
 from tailbeam.errors import InputError, WorkLimitError, require_nonnegative, require_positive
-from tailbeam.modal import ModalBasis
-from tailbeam.plate.model import check_points
+from tailbeam.plate.basis import ModalBasis
+from tailbeam.plate.fe.model import check_points
 
 MAX_RITZ_VECTORS = 1024  # k x points: memory n_dofs x this x 8 B (250 MB at 30 000 DOFs)
 K_START = 16  # choose_ritz_k's first k (fewer ring coherently: docs/fe-convergence.md)
@@ -137,7 +137,7 @@ _MASS_KEPT: dict = {}  # id(Phi_kept) -> (Phi_kept, M Phi_kept), the last KRYLOV
 
 def _mass_kept(basis) -> np.ndarray:
     """M Phi_kept (n_dofs, modes) of ``basis``, computed once per set of kept modes (a sweep's
-    cases share the bases read from the cache, tailbeam.plate.modes._from_cache)."""
+    cases share the bases read from the cache, tailbeam.plate.fe.modes._from_cache)."""
     kept = basis.mode_vectors
     return _remember(_MASS_KEPT, id(kept), kept, lambda: basis.fe_model().mass @ kept)
 

@@ -1,6 +1,6 @@
 """An accelerometer chain on the plate: what a real sensor + DAQ would record (m/s^2).
 
-The chain, per ``tailbeam.scene.SensorSpec``:
+The chain, per ``SensorSpec``:
 1. the true plate acceleration normal to the plate at the sensor point, evaluated exactly (modal
    closed form) on a fine grid, ``oversample`` times the output rate (>= 2.5 x the top mode);
 2. the mounted accelerometer: a lightly damped 2nd-order resonance (seismic mass on the crystal
@@ -28,14 +28,50 @@ import numpy as np
 from scipy import fft as sp_fft
 from scipy import signal
 
-from tailbeam.errors import InputError
-from tailbeam.scene import SensorSpec
-from tailbeam.signals.noise import noise
+from tailbeam.errors import InputError, require_positive, require_vector
+from tailbeam.signals.noise import NoiseSpec, noise
 
 BANDWIDTH_FRACTION = 1.0 / 2.56  # of the sample rate
 RESONANCE_FACTOR = 3.0  # mounted resonance / bandwidth
 RESONANCE_DAMPING = 0.03
 STOPBAND_DB = 90.0
+
+
+@dataclass(frozen=True)
+class SensorSpec:
+    """An accelerometer on the plate, measuring acceleration normal to it (m/s^2).
+
+    position (x, y) in m; sample_rate in Hz; bandwidth_hz: upper edge of the usable band
+    (None: chosen from the sample rate); mounted_resonance_hz (None: chosen from the bandwidth).
+    """
+
+    name: str
+    position: tuple[float, float]
+    sample_rate: float = 51200.0
+    bandwidth_hz: float | None = None
+    mounted_resonance_hz: float | None = None
+    noise: NoiseSpec | None = None  # measurement noise added to the output (tailbeam.signals.noise)
+
+    def __post_init__(self):
+        field_ = f"sensors[{self.name}]"
+        object.__setattr__(self, "position", require_vector(f"{field_}.position", self.position, 2))
+        object.__setattr__(
+            self, "sample_rate", require_positive(f"{field_}.sample_rate", self.sample_rate)
+        )
+        if self.bandwidth_hz is not None:
+            bw = require_positive(f"{field_}.bandwidth", self.bandwidth_hz)
+            if bw >= 0.5 * self.sample_rate:
+                raise InputError(
+                    f"{field_}.bandwidth",
+                    f"must be below Nyquist, {0.5 * self.sample_rate:g} Hz, got {bw:g}",
+                )
+            object.__setattr__(self, "bandwidth_hz", bw)
+        if self.mounted_resonance_hz is not None:
+            object.__setattr__(
+                self,
+                "mounted_resonance_hz",
+                require_positive(f"{field_}.mounted_resonance", self.mounted_resonance_hz),
+            )
 
 
 @dataclass(frozen=True)

@@ -8,5 +8,5 @@
   solver.
 
 Depends on the physics layer (``tailbeam.physics``), the plate (``tailbeam.plate``, through
-``tailbeam.modal``) and the sensor chain (``tailbeam.signals``), never on ``tailbeam.paper``.
+``tailbeam.plate.basis``) and the sensor chain (``tailbeam.signals``), never on ``tailbeam.paper``.
 """

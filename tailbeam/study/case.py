@@ -121,7 +121,7 @@ def run_case(scene_toml: str, *_after) -> dict:
     modal plate "band_hz" and "band_force_error" (``_band_columns``)}.
     ``_after`` are ignored (Dask dependencies, e.g. the warmed basis; callers before the
     labels moved into the scene passed the coal materials here)."""
-    from tailbeam.commands.simulate import solve
+    from tailbeam.cli.simulate import solve
     from tailbeam.io.scene_file import loads_scene
 
     t0 = time.perf_counter()

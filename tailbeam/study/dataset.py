@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tailbeam import __version__
+from tailbeam._version import __version__
 from tailbeam.io.scene_file import loads_scene
 
 LABEL_COLUMNS = (

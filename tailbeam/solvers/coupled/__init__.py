@@ -4,14 +4,15 @@ Public API:
     simulate_coupled(balls, basis, laws, duration, *, sensors=(), ...) -> CoupledResult
     simulate_scene_modal(scene) -> CoupledResult   (builds the modal basis from the scene)
     PlateLoads, plate_response(basis, zeta, loads, points, times)   (sparse prescribed loads,
-        one-way: a stream's contacts and dead loads; tailbeam.solvers.coupled.load_response)
+        one-way: a stream's contacts and dead loads; tailbeam.solvers.plate_loads.response)
 """
 
+from tailbeam.plate.basis import DEFAULT_DAMPING_RATIO, modal_damping
 from tailbeam.solvers.coupled.auto import choose_band, simulate_scene_modal
-from tailbeam.solvers.coupled.load_response import plate_response
-from tailbeam.solvers.coupled.loads import PlateLoads
 from tailbeam.solvers.coupled.result import CoupledResult
-from tailbeam.solvers.coupled.solver import DEFAULT_DAMPING_RATIO, modal_damping, simulate_coupled
+from tailbeam.solvers.coupled.solver import simulate_coupled
+from tailbeam.solvers.plate_loads.loads import PlateLoads
+from tailbeam.solvers.plate_loads.response import plate_response
 
 __all__ = [
     "CoupledResult",

@@ -33,7 +33,7 @@ response, which the mode-acceleration correction adds at each sensor when residu
 flexibility is on (CoupledResult.plate_sample, docs/fe-convergence.md).
 
 Cost. Before anything is assembled the basis's DOFs, modes, memory and time are estimated
-(tailbeam.plate.cost) and a band over the limits is refused naming ``plate.fmax``.
+(tailbeam.plate.fe.cost) and a band over the limits is refused naming ``plate.fmax``.
 Theory and mesh: tailbeam.plate.compute_modes(theory="auto") picks them from the band.
 """
 

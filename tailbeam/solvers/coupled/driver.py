@@ -13,22 +13,15 @@ import numpy as np
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics.contact_patch import load_radius
 from tailbeam.physics.hertz import hertz_contact_duration
+from tailbeam.plate.compliance import Compliance
 from tailbeam.progress import task
+from tailbeam.results.records import PLATE, Event, EventCode, EventKind
 from tailbeam.solvers.coupled import kernel as K
 from tailbeam.solvers.coupled import step as S
-from tailbeam.solvers.coupled.records import Compliance, close_contact
+from tailbeam.solvers.coupled.records import close_contact
 from tailbeam.solvers.coupled.result import CoupledResult
-from tailbeam.solvers.records import PLATE, Event, EventKind
 
 NODE_CAPACITY = 65536  # nodes of the first buffers (they double when full)
-EVENT_NAMES = {
-    K.EV_START: EventKind.CONTACT_START,
-    K.EV_END: EventKind.CONTACT_END,
-    K.EV_DEEP: EventKind.FULL_DAMPING,
-    K.EV_SHALLOW: EventKind.FULL_DAMPING,
-    K.EV_CLAMP_ON: EventKind.CLAMP_ON,
-    K.EV_CLAMP_OFF: EventKind.CLAMP_OFF,
-}
 
 
 class CoupledRun:
@@ -203,10 +196,10 @@ class CoupledRun:
                 self._mark_rest(b)
 
     def _on_event(self, kind: int, b: int) -> None:
-        self.events.append(Event(self.t, self.balls[b].name, EVENT_NAMES[kind], PLATE))
-        if kind == K.EV_START:
+        self.events.append(Event(self.t, self.balls[b].name, EventCode(kind).kind, PLATE))
+        if kind == EventCode.CONTACT_START:
             self._start(b)
-        elif kind == K.EV_END:
+        elif kind == EventCode.CONTACT_END:
             self._end(b)
 
     def _start(self, b: int) -> None:

@@ -17,7 +17,7 @@ Contact start and end are located inside their step (cubic Hermite interpolation
 penetration from its values and rates at both step ends); the ball's speed there gives the
 restitution. The peak force (and its time) and the maximum penetration are refined by a
 parabola through the three nodes around the largest one; the contacts are ``Impact`` records
-(``tailbeam.solvers.records``, as every solver's). Nothing is shared with the modal solver
+(``tailbeam.results.records``, as every solver's). Nothing is shared with the modal solver
 (``tailbeam.solvers.coupled.solver``) but the mesh, the element assembly and the contact law's
 formula.
 
@@ -35,7 +35,7 @@ from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball
 from tailbeam.physics.contact_law import ImpactLaw, impact_force_scalar
 from tailbeam.progress import task
-from tailbeam.solvers.records import Impact
+from tailbeam.results.records import Impact
 
 DEFAULT_MAX_WORK = 1e11  # steps x 10 x matrix nonzeros; 1e11 is ~1-2 min on one core
 

@@ -19,10 +19,10 @@ import math
 import numpy as np
 from numba import njit
 
+from tailbeam.results.records import EventCode
 from tailbeam.solvers.coupled.step import CLAMPED, CONTACT, FLIGHT, solve_step
-from tailbeam.solvers.jit import helper_njit
+from tailbeam.solvers.numerics.jit import helper_njit
 
-EV_NONE, EV_START, EV_END, EV_DEEP, EV_SHALLOW, EV_CLAMP_ON, EV_CLAMP_OFF = range(7)
 ST_STOP, ST_EVENT, ST_FULL, ST_FAIL, ST_STEPS = range(5)
 
 
@@ -51,11 +51,11 @@ def _bounds(ctx, st, f0m, f1m, tau, g):
 
 @njit(cache=True)
 def _event_value(kind, b, aux, d):
-    if kind == EV_START:
+    if kind == EventCode.CONTACT_START:
         return -aux[0, b]  # gap
-    if kind == EV_END:
+    if kind == EventCode.CONTACT_END:
         return aux[0, b]
-    if kind == EV_DEEP or kind == EV_SHALLOW:
+    if kind == EventCode.FULL_DAMPING:
         return aux[0, b] - d[b]
     return aux[2, b]
 
@@ -171,29 +171,28 @@ def _certify(b, tau, ctx, st, out, g, L, A, gap0, rate0, guess):
 @helper_njit
 def _pending_event(F, mode, deep, cur, d, clampf):
     """Apply the first event that happened at the same instant as the one that ended the
-    previous run (found in the step-end quantities ``cur``): (kind, ball), or EV_NONE."""
+    previous run (found in the step-end quantities ``cur``): (kind, ball), or EventCode.NONE."""
     for b in range(mode.shape[0]):
         touching = mode[b] == CONTACT or mode[b] == CLAMPED
         if mode[b] == FLIGHT and cur[0, b] >= 0.0:
             mode[b] = CONTACT
             deep[b] = cur[0, b] > d[b]
-            return EV_START, b
+            return EventCode.CONTACT_START, b
         elif touching and cur[0, b] < 0.0:
             mode[b] = FLIGHT
             F[b] = 0.0
             deep[b] = False
-            return EV_END, b
+            return EventCode.CONTACT_END, b
         elif touching and (cur[0, b] > d[b]) != deep[b]:
-            kd = EV_SHALLOW if deep[b] else EV_DEEP
             deep[b] = not deep[b]
-            return kd, b
+            return EventCode.FULL_DAMPING, b
         elif clampf[b] and mode[b] == CONTACT and cur[2, b] < 0.0:
             mode[b] = CLAMPED
-            return EV_CLAMP_ON, b
+            return EventCode.CLAMP_ON, b
         elif clampf[b] and mode[b] == CLAMPED and cur[2, b] > 0.0:
             mode[b] = CONTACT
-            return EV_CLAMP_OFF, b
-    return EV_NONE, -1
+            return EventCode.CLAMP_OFF, b
+    return EventCode.NONE, -1
 
 
 @njit(cache=True)
@@ -252,16 +251,16 @@ def _contact_kinds(b, mode, deep, aux, d, clampf, kinds):
     if not (mode[b] == CONTACT or mode[b] == CLAMPED):
         return nk
     if aux[0, b] < 0.0:
-        kinds[nk] = EV_END
+        kinds[nk] = EventCode.CONTACT_END
         nk += 1
     if (aux[0, b] > d[b]) != deep[b]:
-        kinds[nk] = EV_SHALLOW if deep[b] else EV_DEEP
+        kinds[nk] = EventCode.FULL_DAMPING
         nk += 1
     if clampf[b] and mode[b] == CONTACT and aux[2, b] < 0.0:
-        kinds[nk] = EV_CLAMP_ON
+        kinds[nk] = EventCode.CLAMP_ON
         nk += 1
     if clampf[b] and mode[b] == CLAMPED and aux[2, b] > 0.0:
-        kinds[nk] = EV_CLAMP_OFF
+        kinds[nk] = EventCode.CLAMP_OFF
         nk += 1
     return nk
 
@@ -269,7 +268,7 @@ def _contact_kinds(b, mode, deep, aux, d, clampf, kinds):
 @njit(cache=True)
 def _keep(hit, kd, b, best, kind_best, b_best, out2, out_best):
     """Keep event kd of ball b at hit (s) (solution in out2) if it is the earliest so far."""
-    if hit < best or kind_best == EV_NONE:
+    if hit < best or kind_best == EventCode.NONE:
         _copy_out(out2, out_best)
         return hit, kd, b
     return best, kind_best, b_best
@@ -299,10 +298,10 @@ def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kin
         if lo >= 0.0:
             if flo == 0.0:
                 flo = 1e-300
-            hit = _locate(EV_START, b, lo, flo, hi, fhi, ctx, st, out2, g, d, guess)
+            hit = _locate(EventCode.CONTACT_START, b, lo, flo, hi, fhi, ctx, st, out2, g, d, guess)
             if hit < 0.0:
                 return False, best, kind_best, b_best
-            best, kind_best, b_best = _keep(hit, EV_START, b, best, kind_best, b_best, out2,
+            best, kind_best, b_best = _keep(hit, EventCode.CONTACT_START, b, best, kind_best, b_best, out2,
                                             out_best)  # fmt: skip
     return True, best, kind_best, b_best
 
@@ -344,20 +343,20 @@ def _record(bt, bz, bvz, bF, bd, nbuf, t, z, vz, F, cur):
 @helper_njit
 def _apply_event(kind, b, F, mode, deep, cur, hist, d):
     """Change ball b's mode for the event kind located at the step's end (st accepted)."""
-    if kind == EV_START:
+    if kind == EventCode.CONTACT_START:
         mode[b] = CONTACT
         deep[b] = cur[0, b] > d[b]
-    elif kind == EV_END:
+    elif kind == EventCode.CONTACT_END:
         mode[b] = FLIGHT
         F[b] = 0.0
         deep[b] = False
-    elif kind == EV_DEEP or kind == EV_SHALLOW:
+    elif kind == EventCode.FULL_DAMPING:
         deep[b] = cur[0, b] > d[b]
-    elif kind == EV_CLAMP_ON:
+    elif kind == EventCode.CLAMP_ON:
         mode[b] = CLAMPED
     else:
         mode[b] = CONTACT
-    if kind != EV_DEEP and kind != EV_SHALLOW:
+    if kind != EventCode.FULL_DAMPING:
         # dF/dt jumps here (the STEP kink keeps it continuous): restart the BDF2 history
         hist[0, b] = 0.0
         hist[1, b] = 0.0
@@ -380,7 +379,7 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
     fm = np.empty(n)
     kinds = np.zeros(4, dtype=np.int64)  # events of one ball in a step
     evout[0], evout[1] = _pending_event(F, mode, deep, cur, d, clampf)
-    if evout[0] != EV_NONE:
+    if evout[0] != EventCode.NONE:
         return ST_EVENT, t, nbuf, 0
     steps = 0
     while t < t_stop:
@@ -399,18 +398,18 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
         if not solve_step(tau, ctx, st, out, g):
             return ST_FAIL, t, nbuf, steps
         # --- events on this step: keep the earliest
-        best, kind_best, b_best = tau, EV_NONE, -1
+        best, kind_best, b_best = tau, EventCode.NONE, -1
         L, A = _bounds(ctx, st, f0m, f1m, tau, g)
         for b in range(nb):
             nk = _contact_kinds(b, mode, deep, aux, d, clampf, kinds)
             if nk == 0 and mode[b] != FLIGHT:
-                continue  # (nothing to locate: no tuples handed over, see tailbeam.solvers.jit)
+                continue  # (nothing to locate: no tuples handed over, see tailbeam.solvers.numerics.jit)
             ok, best, kind_best, b_best = _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L,
                                                        A, guess, best, kind_best, b_best, mode,
                                                        cur, d, kinds, nk)  # fmt: skip
             if not ok:
                 return ST_FAIL, t, nbuf, steps
-        if kind_best != EV_NONE:
+        if kind_best != EventCode.NONE:
             # the solution at the located time, exactly as the root finder checked its sign
             tau = best
             _copy_out(out_best, out)
@@ -418,7 +417,7 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
         t = t + tau
         _record(bt, bz, bvz, bF, bd, nbuf, t, z, vz, F, cur)
         nbuf += 1
-        if kind_best != EV_NONE:
+        if kind_best != EventCode.NONE:
             _apply_event(kind_best, b_best, F, mode, deep, cur, hist, d)
             evout[0] = kind_best
             evout[1] = b_best

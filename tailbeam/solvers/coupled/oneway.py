@@ -35,7 +35,7 @@ def simulate_one_way(
 ) -> CoupledResult:
     """Rigid-plate impacts (tailbeam.solvers.rigid) whose force histories drive the modal plate;
     ``laws``: the balls' ``ContactTable`` or one ball-plate ImpactLaw per ball."""
-    from tailbeam.solvers.coupled.solver import modal_damping
+    from tailbeam.plate.basis import modal_damping
 
     kwargs = {} if rest_speed is None else {"rest_speed": rest_speed}
     if gravity != STANDARD_GRAVITY:

@@ -1,35 +1,10 @@
-"""Bookkeeping of the coupled driver: residual compliance at contact points (cached) and the
-Impact record of a finished contact."""
+"""The Impact record of a finished contact of the coupled driver."""
 
 import math
-import weakref
 
 import numpy as np
 
-from tailbeam.modal import ModalBasis
-from tailbeam.solvers.records import Impact
-
-_COMPLIANCE_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
-class Compliance:
-    """Residual compliance at contact points, cached per basis (the static solve is slow).
-
-    radius: the load model's disc radius (tailbeam.physics.contact_patch.load_radius, already on its
-    5 % logarithmic grid; 0 for a point load)."""
-
-    def __init__(self, basis: ModalBasis, enabled: bool):
-        self.basis = basis
-        self.enabled = enabled
-        self.cache = _COMPLIANCE_CACHE.setdefault(basis, {})
-
-    def __call__(self, x, y, radius):
-        if not self.enabled:
-            return 0.0
-        key = (round(x, 9), round(y, 9), radius)
-        if key not in self.cache:
-            self.cache[key] = float(self.basis.residual_compliance([[x, y]], radius)[0])
-        return self.cache[key]
+from tailbeam.results.records import Impact
 
 
 def close_contact(info, b, ball, t_end, v_out, bufs, nbuf, radius, gravity, *, at_rest, z=math.nan):

@@ -1,6 +1,6 @@
 """What a coupled (flexible-plate) simulation returns.
 
-A ``tailbeam.result.Result`` with the same attributes as ``tailbeam.solvers.rigid.RigidResult``
+A ``tailbeam.results.result.Result`` with the same attributes as ``tailbeam.solvers.rigid.RigidResult``
 (impacts, events, rest_time, sample, time_grid, n_steps, status, message, impacts_table,
 particles_table) plus the plate: ``modal_sample`` / ``plate_sample`` give the
 exact modal state and the deflection, velocity and acceleration at any points and times (closed
@@ -15,8 +15,8 @@ from functools import cached_property
 
 import numpy as np
 
-from tailbeam.result import BallsResult
-from tailbeam.solvers.coupled.propagator import replay
+from tailbeam.results.result import BallsResult
+from tailbeam.solvers.plate_loads.propagator import replay
 
 
 @dataclass(eq=False)

@@ -5,34 +5,15 @@
 ``tailbeam.solvers.coupled.oneway``.
 """
 
-import numpy as np
-
 from tailbeam.errors import InputError, require_positive
-from tailbeam.modal import ModalBasis
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, check_ball_above_plate
 from tailbeam.physics.contacts import contact_table
+from tailbeam.plate.basis import DEFAULT_DAMPING_RATIO, ModalBasis, modal_damping
 from tailbeam.solvers.coupled.driver import CoupledRun
 from tailbeam.solvers.coupled.result import CoupledResult
 
-DEFAULT_DAMPING_RATIO = 0.01  # of every mode; README "Defaults" (welded steel, light joints)
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid solver's value, so both models stop alike
 DEFAULT_STEPS_PER_CONTACT = 200  # steps per Hertz contact duration: ~1e-5 relative error
-
-
-def modal_damping(omega, damping_ratio=DEFAULT_DAMPING_RATIO, rayleigh=None) -> np.ndarray:
-    """Damping ratio of each mode: constant, or Rayleigh zeta = alpha/(2 omega) + beta omega/2."""
-    omega = np.asarray(omega, dtype=float)
-    if rayleigh is not None:
-        alpha, beta = rayleigh
-        if alpha < 0 or beta < 0:
-            raise InputError("plate.rayleigh", "alpha and beta must be >= 0")
-        zeta = alpha / (2.0 * omega) + 0.5 * beta * omega
-        if np.any(zeta >= 1.0):
-            raise InputError("plate.rayleigh", "gives a damping ratio >= 1 for some mode")
-        return zeta
-    if not 0 <= damping_ratio < 1:
-        raise InputError("plate.damping_ratio", f"must be in [0, 1), got {damping_ratio!r}")
-    return np.full(omega.shape, float(damping_ratio))
 
 
 def simulate_coupled(

@@ -18,8 +18,8 @@ import numpy as np
 from numba import njit
 
 from tailbeam.physics.impact import force_partials
-from tailbeam.solvers.coupled.propagator import A1, B1, advance, coefficients
-from tailbeam.solvers.jit import helper_njit
+from tailbeam.solvers.numerics.jit import helper_njit
+from tailbeam.solvers.plate_loads.propagator import A1, B1, advance, coefficients
 
 FLIGHT, CONTACT, CLAMPED, REST, OFF = 0, 1, 2, 3, 4
 

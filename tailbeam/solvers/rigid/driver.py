@@ -21,7 +21,7 @@ import numpy as np
 
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics.contacts import contact_table
-from tailbeam.solvers.records import PLATE, Event, EventKind, Impact
+from tailbeam.results.records import PLATE, Event, EventKind, Impact
 from tailbeam.solvers.rigid.model import Pair, make_pairs, time_to_contact
 from tailbeam.solvers.rigid.result import RigidResult
 from tailbeam.solvers.rigid.trajectory import TrajectoryBuilder

@@ -31,34 +31,15 @@ import math
 import numpy as np
 from numba import njit
 
-from tailbeam.solvers.jit import helper_njit
-from tailbeam.solvers.rigid.dop853 import (  # noqa: F401  (dop853_tables: re-exported)
-    dense_coefficients,
-    dop853_tables,
-    growth,
-    shrink,
-    step,
-)
-from tailbeam.solvers.rigid.regions import (  # noqa: F401  (re-exported for solver.py)
+from tailbeam.physics.contact_law import LAW_C, LAW_CLAMP, LAW_D
+from tailbeam.results.records import EventCode
+from tailbeam.solvers.numerics.dop853 import growth, shrink
+from tailbeam.solvers.numerics.jit import helper_njit
+from tailbeam.solvers.rigid.regions import (
     EPS,
-    EV_CLAMP_OFF,
-    EV_CLAMP_ON,
-    EV_END,
-    EV_FULL,
-    EV_REST,
-    EVENT_NAMES,
     INTERIOR,
     N_WATCH,
-    P_C,
-    P_CLAMP,
-    P_D,
     P_EREST,
-    ST_BUFFER_FULL,
-    ST_DURATION,
-    ST_REST,
-    ST_SEPARATED,
-    ST_STEP_LIMIT,
-    ST_STEP_TINY,
     W_CLAMP,
     W_FULL,
     W_PEAK,
@@ -71,7 +52,10 @@ from tailbeam.solvers.rigid.regions import (  # noqa: F401  (re-exported for sol
     find_root,
     watch_all,
 )
+from tailbeam.solvers.rigid.step import dense_coefficients, step
 
+# how integrate_contact ended (ires[I_STATUS])
+ST_SEPARATED, ST_REST, ST_DURATION, ST_STEP_LIMIT, ST_BUFFER_FULL, ST_STEP_TINY = range(6)
 # res and ires (the outputs) double as the running maxima and counters of the loop
 R_TAU, R_VOUT, R_PEAK, R_TPEAK, R_PEN = range(5)
 I_STATUS, I_PIECES, I_EVENTS, I_NFEV, I_STEPS, I_ATTEMPTS = range(6)
@@ -88,7 +72,7 @@ def _watch_flags(direction, active, ramp, clamped, to_end, par):
     direction[W_UMAX] = -1.0
     direction[W_PEAK] = -1.0
     active[W_FULL] = True
-    active[W_CLAMP] = par[P_CLAMP] > 0.0 and par[P_C] > 0.0
+    active[W_CLAMP] = par[LAW_CLAMP] > 0.0 and par[LAW_C] > 0.0
     active[W_SEP] = not to_end
     active[W_REST] = par[P_EREST] > 0.0
     active[W_UMAX] = True
@@ -243,9 +227,9 @@ def _switch_region(w_sw, d_ev, ramp, clamped, par):
     """The region after kink w_sw (full damping or clamp): (delta m to restart from, ramp,
     clamped, event code); the full-damping restart sits exactly on delta = d."""
     if w_sw == W_FULL:
-        return par[P_D], not ramp, clamped, EV_FULL
+        return par[LAW_D], not ramp, clamped, EventCode.FULL_DAMPING
     clamped = not clamped
-    return d_ev, ramp, clamped, EV_CLAMP_ON if clamped else EV_CLAMP_OFF
+    return d_ev, ramp, clamped, EventCode.CLAMP_ON if clamped else EventCode.CLAMP_OFF
 
 
 @helper_njit
@@ -315,7 +299,7 @@ def integrate_contact(
         if w_sw < 0:
             _update_maxima(res, force_b, tau + h, n0, res[R_PEN], res[R_PEAK], res[R_TPEAK])
             if to_end:
-                _log(ev_tau, ev_kind, ires, tau + h, EV_END)
+                _log(ev_tau, ev_kind, ires, tau + h, EventCode.CONTACT_END)
                 return _finish(res, ires, ST_SEPARATED, tau + h, -n1)
             tau = tau_max if last else tau + h
             y0, y1, f0, f1, fresh_w, h = n0, n1, K[12, 0], K[12, 1], -1, h_next
@@ -324,7 +308,7 @@ def integrate_contact(
         tau, d_ev, u_ev = _at_kink(x_sw, tau, h, y0, y1, W[0], ramp, clamped, par, W[1], res)
         if w_sw == W_SEP or (d_ev <= 0.0 and u_ev < 0.0):
             # (a kink this close to the separation that the restart state is already out)
-            _log(ev_tau, ev_kind, ires, tau, EV_END)
+            _log(ev_tau, ev_kind, ires, tau, EventCode.CONTACT_END)
             return _finish(res, ires, ST_SEPARATED, tau, -u_ev)
         if w_sw == W_REST:
             return _finish(res, ires, ST_REST, tau, 0.0)

@@ -17,7 +17,7 @@ from scipy.integrate import solve_ivp
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics import impact
 from tailbeam.physics.bodies import STANDARD_GRAVITY
-from tailbeam.solvers.records import EventKind
+from tailbeam.results.records import EventKind
 from tailbeam.solvers.rigid import driver
 from tailbeam.solvers.rigid.model import (
     DEFAULT_MAX_CONTACTS,

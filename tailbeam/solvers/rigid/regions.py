@@ -11,22 +11,15 @@ import numpy as np
 from numba import njit
 
 from tailbeam.physics import impact
-from tailbeam.solvers.records import EventKind
+from tailbeam.physics.contact_law import LAW_C, LAW_COLUMNS, LAW_D, LAW_E, LAW_K
 
-# parameter vector layout
-P_M, P_G, P_K, P_E, P_C, P_D, P_CLAMP, P_EREST, P_ETRAP = range(9)
-N_PAR = 9
+# the parameter vector: the law's columns (LAW_K ... LAW_CLAMP), then the ball's own
+P_M, P_G, P_EREST, P_ETRAP = range(LAW_COLUMNS, LAW_COLUMNS + 4)
+N_PAR = LAW_COLUMNS + 4
 # watched functions
 W_FULL, W_CLAMP, W_SEP, W_REST, W_UMAX, W_PEAK = range(6)
 N_WATCH = 6
-# event codes written to the event buffer
-EV_FULL, EV_CLAMP_ON, EV_CLAMP_OFF, EV_END, EV_REST = range(5)
-EVENT_NAMES = (EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF,
-               EventKind.CONTACT_END, EventKind.REST)  # fmt: skip
-# return status
-ST_SEPARATED, ST_REST, ST_DURATION, ST_STEP_LIMIT, ST_BUFFER_FULL, ST_STEP_TINY = range(6)
 
-SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 EPS = np.finfo(float).eps
 INTERIOR = (0.25, 0.5, 0.75)
 
@@ -36,14 +29,14 @@ def accel(delta, u, ramp, clamped, par):
     """du/dt = g - F / m in the region (ramp, clamped)."""
     if clamped or delta <= 0.0:
         return par[P_G]
-    k, e, c, d = par[P_K], par[P_E], par[P_C], par[P_D]
+    k, e, c, d = par[LAW_K], par[LAW_E], par[LAW_C], par[LAW_D]
     return par[P_G] - impact.region_force(delta, u, k, e, c, d, ramp, False) / par[P_M]
 
 
 @njit(cache=True)
 def watch_all(delta, u, ramp, clamped, par, out):
     """Values of all watched functions at (delta, u); returns the force in the region."""
-    k, e, c, d, m, g = par[P_K], par[P_E], par[P_C], par[P_D], par[P_M], par[P_G]
+    k, e, c, d, m, g = par[LAW_K], par[LAW_E], par[LAW_C], par[LAW_D], par[P_M], par[P_G]
     out[W_FULL] = delta - d
     out[W_SEP] = delta
     out[W_UMAX] = u

@@ -1,6 +1,6 @@
 """What a rigid-plate simulation returns: the impact table, the events and exact states.
 
-A ``tailbeam.result.Result`` (the common interface: impacts_table, particles_table,
+A ``tailbeam.results.result.Result`` (the common interface: impacts_table, particles_table,
 events_of, time_grid, ...): ``impacts`` and ``events`` are the located events,
 ``sample(times)`` evaluates the stored piecewise solution (closed form in flight, dense output
 in contact) at any times, ``nfev``/``n_steps`` count the work, ``status``/``message`` report
@@ -9,8 +9,8 @@ how it ended.
 
 from dataclasses import dataclass, field
 
-from tailbeam.result import BallsResult
-from tailbeam.solvers.records import EventKind, Impact  # noqa: F401 - Impact: its old home
+from tailbeam.results.records import EventKind, Impact  # noqa: F401 - Impact: its old home
+from tailbeam.results.result import BallsResult
 
 EVENT_KINDS = (EventKind.CONTACT_START, EventKind.FULL_DAMPING, EventKind.CLAMP_ON,
                EventKind.CLAMP_OFF, EventKind.CONTACT_END, EventKind.REST)  # fmt: skip

@@ -12,6 +12,8 @@ import numpy as np
 
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics.bodies import STANDARD_GRAVITY
+from tailbeam.results.records import End, EventCode
+from tailbeam.solvers.numerics.dop853 import dop853_tables
 from tailbeam.solvers.rigid import driver, kernel
 from tailbeam.solvers.rigid.model import (
     DEFAULT_MAX_CONTACTS,
@@ -20,11 +22,8 @@ from tailbeam.solvers.rigid.model import (
     check_rtol,
 )
 
-_STATUS = {
-    kernel.ST_SEPARATED: "separated",
-    kernel.ST_REST: "rest",
-    kernel.ST_DURATION: "duration",
-}
+_ENDS = {kernel.ST_SEPARATED: End.SEPARATED, kernel.ST_REST: End.REST,
+         kernel.ST_DURATION: End.DURATION}  # fmt: skip
 
 
 def simulate_rigid(
@@ -65,7 +64,7 @@ class _KernelIntegrator:
 
     def __init__(self, rtol):
         self.rtol = rtol
-        self.tables = kernel.dop853_tables()
+        self.tables = dop853_tables()
         self._alloc(4096, 512)
         self.res = np.zeros(5)
         self.ires = np.zeros(6, dtype=np.int64)
@@ -84,7 +83,7 @@ class _KernelIntegrator:
         par = self.par.get(p.name)
         if par is None:
             par = np.array(
-                [p.mass, p.gravity, p.k, p.e, p.c, p.d, float(p.clamp), p.e_rest, p.e_trap]
+                [p.k, p.e, p.c, p.d, float(p.clamp), p.mass, p.gravity, p.e_rest, p.e_trap]
             )
             self.par[p.name] = par
         return par
@@ -117,16 +116,15 @@ class _KernelIntegrator:
         self.off_p, self.off_e = op + n, oe + m
         tau_end, v_out, peak, tau_peak, pen = self.res.tolist()
         tau_start = self.p_tau[op : op + n]
-        names = kernel.EVENT_NAMES
         return driver.ContactOutcome(
-            status=_STATUS[status],
+            status=_ENDS[status],
             tau_end=tau_end,
             v_out=v_out,
             peak_force=peak,
             tau_peak=tau_peak,
             max_penetration=pen,
             events=[
-                (t, names[k])
+                (t, EventCode(k).kind)
                 for t, k in zip(
                     self.ev_tau[oe : oe + m].tolist(),
                     self.ev_kind[oe : oe + m].tolist(),

@@ -1,6 +1,6 @@
 """Which solver runs a stream scene: the one switch the fast stream solver replaces.
 
-``stream_engine()`` returns the fast solver ``tailbeam.solvers.stream.stream.simulate_stream`` if
+``stream_engine()`` returns the fast solver ``tailbeam.solvers.stream.driver.loop.simulate_stream`` if
 that module exists, else the slow reference (``simulate_stream_reference``, every pair
 watched, fine for 3-10 balls, refused beyond ``REFERENCE_MAX_PARTICLES``). Both are called
 as ``run(particles, incline, duration, *, laws, rtol, max_steps, progress)`` and return a
@@ -8,7 +8,7 @@ as ``run(particles, incline, duration, *, laws, rtol, max_steps, progress)`` and
 ``tailbeam.physics.contacts``) or the IMPACT settings shared by every pair (exponent,
 damping, penetration, clamp: ``tailbeam.scene.ContactSettings``).
 
-The fast solver plugs in by existing: a module ``tailbeam/solvers/stream/stream.py`` with
+The fast solver plugs in by existing: a module ``tailbeam/solvers/stream/driver/loop.py`` with
 ``simulate_stream`` (same call, same result) and optionally ``MAX_PARTICLES``,
 ``DEFAULT_RTOL``, ``DEFAULT_MAX_STEPS`` and ``estimate``; nothing else changes.
 """
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from tailbeam.physics.contacts import contact_table
 from tailbeam.solvers.stream.stream_result import StreamResult
 
-FAST_MODULE = "tailbeam.solvers.stream.stream"
+FAST_MODULE = "tailbeam.solvers.stream.solver"
 REFERENCE_MAX_PARTICLES = 20  # the reference watches every pair: O(N^2) per step
 REFERENCE_MAX_STEPS = 100_000  # default step budget (memory: every step's state is kept)
 REFERENCE_RTOL = 1e-10
@@ -87,7 +87,7 @@ def reference_estimate(n_particles: int, max_steps: int) -> tuple[float, float]:
 
 def run_reference(particles, incline, duration, *, laws, rtol, max_steps, progress=None):
     """Run ``particles`` through ``simulate_stream_reference``; returns a StreamResult."""
-    from tailbeam.solvers.stream.stream_reference import simulate_stream_reference
+    from tailbeam.solvers.stream.reference.solver import simulate_stream_reference
 
     ref = simulate_stream_reference(
         [p.ball() for p in particles],

@@ -1,12 +1,12 @@
 """What a stream simulation returns: particles, contacts, leave events, as columns.
 
 ``StreamResult`` is built by every stream solver (the slow reference today, the fast solver
-when it lands) from the shared records of ``tailbeam.solvers.records``. Its two tables are
+when it lands) from the shared records of ``tailbeam.results.records``. Its two tables are
 the outputs ``impacts.csv`` and ``particles.csv`` (tailbeam.io.results_io), column for column.
 
-A ``tailbeam.result.Result``: the columns of ``impacts_table()`` and ``particles_table()``
+A ``tailbeam.results.result.Result``: the columns of ``impacts_table()`` and ``particles_table()``
 are documented there (``IMPACT_TABLE_COLUMNS``, ``PARTICLE_COLUMNS``); this module fills the
-twelve historical ones from the stream records (``tailbeam.solvers.records.Impact``, the
+twelve historical ones from the stream records (``tailbeam.results.records.Impact``, the
 record of every solver), of which it numbers ``index`` and sets ``next_apex_height`` when
 built (``number_contacts``: both need the whole run):
 ``restitution`` is approach_out / approach_in of the pair (v_out / v_in for a plate row),
@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tailbeam.result import (  # noqa: F401 - the column names, as imported before
+from tailbeam.results.records import PLATE
+from tailbeam.results.result import (  # noqa: F401 - the column names, as imported before
     IMPACT_COLUMNS,
     IMPACT_TABLE_COLUMNS,
     IMPACT_TABLE_UNITS,
@@ -37,7 +38,6 @@ from tailbeam.result import (  # noqa: F401 - the column names, as imported befo
     TEXT_COLUMNS,
     Result,
 )
-from tailbeam.solvers.records import PLATE
 
 # The stream columns were named so before every scene wrote them (kept for importers).
 STREAM_IMPACT_COLUMNS = IMPACT_TABLE_COLUMNS
@@ -50,7 +50,7 @@ class StreamResult(Result):
 
     particles: ``tailbeam.streams.generator.Particle`` of every body, ``[[balls]]`` included
     (stream "", t_release 0); contacts: ``Impact`` records (one per ball per contact);
-    leaves: ``LeaveEvent``; events: ``tailbeam.solvers.records.Event`` in time order; incline:
+    leaves: ``LeaveEvent``; events: ``tailbeam.results.records.Event`` in time order; incline:
     ``tailbeam.physics.incline.InclinedPlate``; duration in s; status 0 = reached the end;
     message; stats: solver statistics (steps, ...); sensors: sensor outputs by name once
     the modal plate carries streams (None until then); info: what was chosen.

@@ -1,1 +1,0 @@
-"""Sub-commands of the ``tailbeam`` CLI, one module each."""
