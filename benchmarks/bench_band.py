@@ -5,7 +5,7 @@
 Scene: examples/thirty_balls_modal.toml (30 coal and sandstone balls, radius 10-40 mm, 3 m/s,
 on a 6 x 5 grid of the default SSSS steel plate; two sensors at 51.2 kHz, 20 kHz band).
 Rows:
-- "auto": default settings (the band, theory and mesh tailbeam.solvers.coupled.auto chooses);
+- "auto": default settings (the band, theory and mesh tailbeam.solvers.modal_setup.band chooses);
 - "fmax N kHz": the same scene with [plate] fmax = N kHz, default steps;
 - "converged": fmax 40 kHz (30 kHz with --quick) and 400 steps per contact (default 200):
   the truth every row is compared with. The 40 vs 30 kHz difference is its own error estimate.
@@ -34,7 +34,7 @@ import numpy as np
 
 from tailbeam.io.output import atomic_output_dir
 from tailbeam.io.scene_file import load_scene
-from tailbeam.solvers.coupled.auto import (
+from tailbeam.solvers.modal_setup.band import (
     _contacts,
     describe_choices,
     force_error_estimate,

@@ -33,13 +33,15 @@ from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.materials import SANDSTONE
 from tailbeam.progress import quiet
 from tailbeam.scene import DEFAULT_TAIL_MODES, ContactSettings, ModalPlateSettings, Scene
-from tailbeam.solvers.coupled.auto import build_basis, choose_band, simulate_scene_modal
 from tailbeam.solvers.coupled.fe_reference import (
     QUANTITIES,
     impact_quantities,
     in_band,
     relative_l2,
 )
+from tailbeam.solvers.modal_setup.band import choose_band
+from tailbeam.solvers.modal_setup.setup import build_basis
+from tailbeam.solvers.single_ball import simulate_scene_modal
 
 ROOT = Path(__file__).parents[1]
 FIXED_K = (32, 64)  # also run with plate.tail_modes set (32 is the default) on default/sweep
@@ -90,7 +92,7 @@ def _contact_errors(res, q_ref) -> dict:
 
 
 def _sensor_error(res, t, a_ref, point, band_hz):
-    a = res.plate_sample(t, [point])["a"][0]
+    a = res.plate.sample(t, [point])["a"][0]
     return relative_l2(in_band(t, a, band_hz), a_ref)
 
 
@@ -109,7 +111,7 @@ def case_test():
     for tail, extra in _variants(fixed=()):
         res, run_s, build_s = _run(_with_tail(scene, tail, **extra), basis)
         err = _contact_errors(res, q_ref)
-        a = in_band(ref.t, res.plate_sample(ref.t, [case.sensor])["a"][0], 10_000.0)
+        a = in_band(ref.t, res.plate.sample(ref.t, [case.sensor])["a"][0], 10_000.0)
         err["sensor"] = relative_l2(a[win], a_ref[win])
         rows.append(_row("test (8x8, 20 kHz)", tail, res, basis, run_s, build_s, err))
     return rows
@@ -148,7 +150,7 @@ def case_sweep():
     truth, _, _ = _run(truth_scene, truth_basis, repeats=1)
     truth_qs, _, _ = _run(_with_tail(truth_scene, "quasi-static"), truth_basis, repeats=1)
     t = np.arange(0.0, base.duration, 1.0 / 51200.0)
-    a_ref = in_band(t, truth.plate_sample(t, [point])["a"][0], 5000.0)
+    a_ref = in_band(t, truth.plate.sample(t, [point])["a"][0], 5000.0)
     q_ref = impact_quantities(truth.impacts[0])
     uncertainty = _contact_errors(truth_qs, q_ref)["contact"]
     print(f"sweep truth: {truth_basis.n_modes} modes at 40 kHz ({basis.theory}, {divisions} "
@@ -169,7 +171,7 @@ def _row(case, tail, res, basis, run_s, build_s, err):
     if info.get("model") == "ritz":
         tail = f"{tail}, tail_modes = {info['tail_modes']}"
     return {"case": case, "tail": tail, "k": info.get("k", "-"),
-            "modes": res.basis.n_modes, "prepass_s": build_s, "run_s": run_s,
+            "modes": res.plate.basis.n_modes, "prepass_s": build_s, "run_s": run_s,
             "contact": err.get("contact"), "sensor": err.get("sensor")}  # fmt: skip
 
 

@@ -10,7 +10,7 @@ stream solver, with the band at 10, 20 and 40 kHz (FE bases, cached after the fi
 The plate is at rest: this is the band's own effect on one contact, without the stream's
 chaos (docs/streams.md). Reports the peak
 force, contact duration and rebound speed at 10 and 20 kHz relative to 40 kHz, beside the
-a-priori estimate the stream's band check gives at 10 kHz (tailbeam.solvers.coupled.auto:
+a-priori estimate the stream's band check gives at 10 kHz (tailbeam.solvers.modal_setup.band:
 an upper estimate) and the band it would ask for. Beside them the 10 kHz band with the dynamic
 contact tail (``plate.tail = "ritz"``: 4 oscillators per contact for the modes from 10 to
 40 kHz, tailbeam.plate.contact_tail), against the 40 kHz basis and against a 40 kHz
@@ -25,7 +25,7 @@ from pathlib import Path
 
 import tailbeam
 from tailbeam.io.scene_file import loads_scene
-from tailbeam.solvers.coupled.auto import contact_band, force_error_estimate, impact_pulse
+from tailbeam.solvers.modal_setup.band import contact_band, force_error_estimate, impact_pulse
 
 BANDS = (10000.0, 20000.0, 40000.0)
 SCENE = """
@@ -71,7 +71,7 @@ def estimate(scene, speed: float) -> tuple[float, float]:
 
 def band_divisions() -> int:
     """Mesh divisions of the 10 kHz basis (the mesh its contact tail is built on)."""
-    from tailbeam.solvers.coupled.auto import build_basis
+    from tailbeam.solvers.modal_setup.setup import build_basis
 
     text = SCENE.format(fmax=1e4, material="coal", radius=0.01, z=1.0, vz=0.0, extra="")
     return int(build_basis(loads_scene(text), {"fmax_hz": 1e4}).info["divisions"])

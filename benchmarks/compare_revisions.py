@@ -80,6 +80,12 @@ def _events(events) -> list:
     return out
 
 
+def _nodes(result):
+    """The coupled solver's force nodes, where the revision keeps them (the result itself
+    before 0.3.0, its plate part since)."""
+    return result.nodes if hasattr(result, "nodes") else result.plate.nodes
+
+
 def run_solvers(out_path, quick):
     """Run the scenes with the tailbeam on sys.path; pickle their flattened results."""
     import stream_scenes
@@ -134,7 +140,7 @@ def run_solvers(out_path, quick):
     ball = Ball("s", SANDSTONE, 0.03, (0.07, -0.05, 0.03 + 1e-4), (0.0, 0.0, -2.0))
     slaw = ball_plate_law(SANDSTONE, 0.03, CARBON_STEEL, damping=800.0)
     coupled = simulate_coupled([ball], basis, [slaw], 2e-3, gravity=9.80665)
-    runs["coupled"] = (coupled.impacts, _events(coupled.events), coupled.nodes)
+    runs["coupled"] = (coupled.impacts, _events(coupled.events), _nodes(coupled))
     if not quick:
         from tailbeam.plate import assemble_plate
 

@@ -46,7 +46,6 @@ from tailbeam.plate.fe.resolution import resolve
 from tailbeam.progress import quiet
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
 from tailbeam.solvers.coupled import records
-from tailbeam.solvers.coupled.auto import simulate_scene_modal
 from tailbeam.solvers.coupled.fe_compare import (
     RECORD_S,
     Case,
@@ -55,14 +54,15 @@ from tailbeam.solvers.coupled.fe_compare import (
     result_errors,
 )
 from tailbeam.solvers.coupled.fe_reference import fe_time_step_study
-from tailbeam.solvers.coupled.ritz_prepass import ritz_tail_basis
+from tailbeam.solvers.modal_setup.ritz_prepass import ritz_tail_basis
+from tailbeam.solvers.single_ball import simulate_scene_modal
 
 R = 0.03
 IMPACT, SENSOR = (0.05, 0.03), (0.05, 0.10)
 BANDS = (10000.0, 14000.0, 20000.0, 28000.0, 40000.0)
 TEST_MESHES = {"kirchhoff": 8, "mindlin": 6}
 VARIANTS = ("no residual", "residual (before)", "residual", "residual + sensor QS")
-RITZ = "ritz tail + sensor QS"  # plate.tail = "ritz" (tailbeam.solvers.coupled.ritz_prepass)
+RITZ = "ritz tail + sensor QS"  # plate.tail = "ritz" (tailbeam.solvers.modal_setup.ritz_prepass)
 DEFAULTS = "default settings (tail auto: ritz, k = 32; 200 steps/contact)"
 
 
@@ -109,7 +109,7 @@ def _default_settings(case, basis, ref, theory, band, divisions):
                   plate_model="modal", modal=modal)  # fmt: skip
     with quiet():
         res = simulate_scene_modal(scene, basis=basis)
-    return dict(result_errors(case, res, ref), n_modes=res.basis.n_modes)
+    return dict(result_errors(case, res, ref), n_modes=res.plate.basis.n_modes)
 
 
 def study_theory(theory, divisions, dt, steps, bands=BANDS):

@@ -60,7 +60,7 @@ def time_rigid(label):
     balls = [Ball(f"b{i}", COAL, 0.03, (-0.2 + 0.04 * i, 0.0, 0.13 + 0.01 * i),
                   (0.0, 0.0, -1.0 - 0.1 * i)) for i in range(10)]  # fmt: skip
     _timed(label, lambda: simulate_rigid(balls, Plate(), [law] * 10, 1.0, rtol=1e-10), REPEATS,
-           lambda r: f"{r.nfev} nfev")  # fmt: skip
+           lambda r: f"{r.nfev if hasattr(r, 'nfev') else r.stats['nfev']} nfev")  # fmt: skip
 
 
 def time_coupled(label):
@@ -78,7 +78,7 @@ def time_coupled(label):
     ball = Ball("s", SANDSTONE, 0.03, (0.07, -0.05, 0.03 + 1e-4), (0.0, 0.0, -2.0))
     law = ball_plate_law(SANDSTONE, 0.03, CARBON_STEEL, damping=800.0)
     _timed(label, lambda: simulate_coupled([ball], basis, [law], 2e-3, gravity=9.80665), 10,
-           lambda r: f"{len(r.nodes[0])} nodes")  # fmt: skip
+           lambda r: f"{len((r.nodes if hasattr(r, 'nodes') else r.plate.nodes)[0])} nodes")  # fmt: skip
 
 
 def time_stream(label):

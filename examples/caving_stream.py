@@ -45,7 +45,7 @@ def scene(gangue_fraction: float, n_particles: int, fmax_hz: float = 10000.0):
 
 
 def run(n_particles: int = 200, fmax_hz: float = 10000.0) -> dict:
-    """name -> StreamResult of each case (progress on stderr)."""
+    """name -> the Result of each case (progress on stderr)."""
     results = {}
     for name, fraction in CASES.items():
         print(f"{name}: {n_particles} particles", file=sys.stderr)
@@ -66,7 +66,7 @@ def summary(results: dict) -> list:
             row[f"median_peak_force_{label}_N"] = (
                 float(np.median(table["peak_force"][sel])) if sel.any() else float("nan")
             )
-        for sensor, out in res.sensors.items():
+        for sensor, out in res.sensor_outputs.items():
             fs = out.chain.sample_rate
             row[f"{sensor}_rms_m_s2"] = float(np.sqrt(np.mean(out.acceleration**2)))
             row[f"{sensor}_centroid_hz"] = float(spectral_centroid(out.acceleration, fs))
@@ -87,9 +87,9 @@ def visualize(results: dict, out_dir) -> Path:
                  "30 % sandstone, on the 30° SSSS modal plate")  # fmt: skip
     forces = np.concatenate([r.impacts_table()["peak_force"] for r in results.values()])
     f_range = (0.5 * max(forces[forces > 0].min(), 1e-3), 2.0 * forces.max())
-    top = max(float(np.max(np.abs(r.sensors["S1"].acceleration))) for r in results.values())
+    top = max(float(np.max(np.abs(r.sensor_outputs["S1"].acceleration))) for r in results.values())
     for col, (name, res) in enumerate(results.items()):
-        out = res.sensors["S1"]
+        out = res.sensor_outputs["S1"]
         ax = axes[0, col]
         ax.plot(out.t, out.acceleration, lw=0.3)
         rms = np.sqrt(np.mean(out.acceleration**2))

@@ -48,7 +48,7 @@ def _impact_numbers(result, name):
         "peak_force_N": first.peak_force,
         "contact_duration_s": first.t_end - first.t_start,
         "bounces": len(impacts),
-        "rest_time_s": result.rest_time[name],
+        "rest_time_s": result.states.rest_time[name],
         "energy_loss_first": 1.0 - first.restitution**2,
     }
 

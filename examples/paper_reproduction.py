@@ -20,7 +20,7 @@ def main(contact: ContactSettings | None = None):
     for c in claims:
         print(f"{'PASS' if c.passed else 'FAIL'}  {c.id:30s} {c.numbers(3)}")
     for key, result in results.items():
-        for ball in result.balls:
+        for ball in result.particles:
             first = result.impacts_of(ball.name)[0]
             print(
                 f"{key:9s} {ball.name:10s} impact {first.v_in:.4f} m/s -> restitution "

@@ -29,6 +29,7 @@ from tailbeam.physics.contacts import PLATE
 from tailbeam.physics.hertz import hertz_max_penetration
 
 MAX_PENETRATION_FRACTION = 0.1  # of the ball radius
+MAX_PARTICLES = 200_000  # per scene: memory ~40 kB per particle (records, force histories)
 MAX_CONTACT_DAMPING_RATIO = 1e4
 MAX_TIMESERIES_VALUES = 20_000_000  # ~300 MB of CSV
 MAX_SENSOR_SAMPLES = 20_000_000  # per sensor; the chain works on a grid 2-4x finer
@@ -106,21 +107,17 @@ def check_outputs(scene) -> None:
             )
 
 
-def check_streams(scene, engine=None) -> None:
-    """Rules for a scene the stream solver runs (streams, an inclined plate or balls that may
-    touch; or any scene given the ``engine`` that will run it, a
-    ``tailbeam.solvers.stream.engine.StreamEngine``): the particle count the solver accepts,
-    from the expected count before the particles are generated and the actual count after;
-    then the contact rules for every stream particle (``streams[i].height`` or ``.velocity``,
-    whichever gives more speed). WorkLimitError names the setting to change."""
-    if engine is None:
-        if not scene.needs_stream_solver:
-            return
-        from tailbeam.solvers.stream.engine import stream_engine
-
-        engine = stream_engine()
-    _check_particle_count(scene, engine, sum(scene.expected_particles()), "expects")
-    _check_particle_count(scene, engine, len(scene.particles) - len(scene.balls), "has")
+def check_streams(scene, max_particles: int | None = MAX_PARTICLES,
+                  solver: str = "fast stream solver") -> None:  # fmt: skip
+    """Rules for a scene a stream solver runs (streams, an inclined plate or balls that may
+    touch; the caller decides): the particle count the ``solver`` accepts (``max_particles``,
+    None: no limit), from the expected count before the particles are generated and the
+    actual count after; then the contact rules for every stream particle
+    (``streams[i].height`` or ``.velocity``, whichever gives more speed). WorkLimitError
+    names the setting to change."""
+    _check_particle_count(scene, max_particles, solver, sum(scene.expected_particles()), "expects")
+    _check_particle_count(scene, max_particles, solver, len(scene.particles) - len(scene.balls),
+                          "has")  # fmt: skip
     streams = {s.name: i for i, s in enumerate(scene.streams, start=1)}
     g_n = scene.gravity * math.cos(math.radians(scene.inclination))
     contacts, first = scene.contacts(), len(scene.balls)
@@ -131,9 +128,9 @@ def check_streams(scene, engine=None) -> None:
         check_ball_contact(ball, law, g_n, f"streams[{streams[p.stream]}].{key}")
 
 
-def _check_particle_count(scene, engine, from_streams: float, verb: str) -> None:
+def _check_particle_count(scene, max_particles, solver, from_streams: float, verb: str) -> None:
     n = len(scene.balls) + from_streams
-    if engine.max_particles is None or n <= engine.max_particles:
+    if max_particles is None or n <= max_particles:
         return
     if scene.streams:
         expected = scene.expected_particles()
@@ -142,8 +139,8 @@ def _check_particle_count(scene, engine, from_streams: float, verb: str) -> None
     else:
         field = "balls"
     raise WorkLimitError(
-        f"{field}: the scene {verb} {n:.4g} particles; the {engine.name} accepts at most "
-        f"{engine.max_particles} (ball-ball contact, streams and inclined plates need the fast "
+        f"{field}: the scene {verb} {n:.4g} particles; the {solver} accepts at most "
+        f"{max_particles} (ball-ball contact, streams and inclined plates need the fast "
         "stream solver beyond that): lower the rate, shorten the streams or the duration"
     )
 
@@ -152,4 +149,5 @@ def check_scene(scene) -> None:
     """Every preflight rule; raises InputError (or WorkLimitError) on the first broken one."""
     check_contacts(scene)
     check_outputs(scene)
-    check_streams(scene)
+    if scene.needs_stream_solver:
+        check_streams(scene)

@@ -19,7 +19,7 @@ from tailbeam.physics.contacts import PLATE, ContactTable
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import Material
 from tailbeam.signals.sensor import SensorSpec
-from tailbeam.streams.generator import Particle, particles_from_settings
+from tailbeam.streams.generator import Particle, default_label, particles_from_settings
 
 # Defaults where the paper is silent (docs/reproduction.md, "Defaults"). d = 0.1 mm is Adams'
 # default penetration depth. c = 300 N s/m was chosen by running the paper's three scenarios over a
@@ -83,7 +83,7 @@ class ModalPlateSettings:
     coupling: "two-way" or "one-way" (rigid-plate forces applied to the plate).
     tail: how the truncated modes act at a contact: "quasi-static" (their static compliance),
     "ritz" (load-dependent Ritz pseudo-modes: on the coupled solver at the balls' first
-    contact points, tailbeam.solvers.coupled.ritz_prepass; on the stream solver a few
+    contact points, tailbeam.solvers.modal_setup.ritz_prepass; on the stream solver a few
     oscillators at every plate contact, tailbeam.plate.contact_tail; needs
     residual_flexibility and two-way coupling) or "auto" (the default: "ritz" where it
     applies, the coupled solver on an FE basis with both; "quasi-static" elsewhere, streams
@@ -159,11 +159,6 @@ class ModalPlateSettings:
                 "'ritz' refines the residual flexibility of two-way coupling; it needs "
                 "residual_flexibility = true and coupling = 'two-way'",
             )
-
-
-def default_label(ball: Ball) -> str:
-    """``coal`` for a ball of the material named coal, ``gangue`` otherwise."""
-    return "coal" if ball.material.name == "coal" else "gangue"
 
 
 @dataclass(frozen=True)
@@ -269,8 +264,7 @@ class Scene:
         ``duration``, in release order. Stream particles are generated on first use
         (deterministic from the seeds)."""
         out = [
-            Particle(b.name, "", label, b.material, b.radius, b.mass, 0.0, b.position, b.velocity)
-            for b, label in zip(self.balls, self.labels, strict=True)
+            Particle.from_ball(b, label) for b, label in zip(self.balls, self.labels, strict=True)
         ]
         if self.streams:
             generated = particles_from_settings(self.streams, self.incline)

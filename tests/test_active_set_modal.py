@@ -45,7 +45,7 @@ def _coupled(ball, law, steps_per_contact):
         residual_flexibility=False, steps_per_contact=steps_per_contact,
     )  # fmt: skip
     imp = res.impacts[0]
-    q, qd, _ = res.modal_sample([imp.t_end])
+    q, qd, _ = res.plate.modal_sample([imp.t_end])
     return (np.array([imp.t_end, imp.v_out, imp.peak_force, imp.max_penetration]), q[:, 0],
             qd[:, 0])  # fmt: skip
 

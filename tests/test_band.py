@@ -1,4 +1,4 @@
-"""The automatic modal band (tailbeam.solvers.coupled.auto): its estimates against independent
+"""The automatic modal band (tailbeam.solvers.modal_setup.band): its estimates against independent
 truths (the SSSS closed-form static compliance and exact SSSS modes), its choice, and its
 refusals."""
 
@@ -13,7 +13,10 @@ from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis, ssss_static_compliance
-from tailbeam.solvers.coupled import auto, simulate_coupled
+from tailbeam.solvers import single_ball
+from tailbeam.solvers.coupled import simulate_coupled
+from tailbeam.solvers.modal_setup import band as auto
+from tailbeam.solvers.modal_setup import setup
 
 PLATE = Plate()
 SCENE = """
@@ -114,7 +117,7 @@ def test_band_is_the_larger_of_sensor_and_contact_needs_and_meets_the_accuracy()
 def test_too_costly_band_is_refused_naming_plate_fmax_before_any_work(tmp_path, capsys):
     for fmax in ("72000.0", "1e6"):
         with pytest.raises(InputError) as info:
-            auto.build_basis(scene(plate=f"fmax = {fmax}"), use_cache=False)
+            setup.build_basis(scene(plate=f"fmax = {fmax}"), use_cache=False)
         assert info.value.field == "plate.fmax", info.value
     path = tmp_path / "scene.toml"
     path.write_text(SCENE.format(plate="fmax = 72000.0", sensors=""))
@@ -135,11 +138,11 @@ def test_overdamped_plate_is_refused_naming_damping_ratio(ratio):
 def test_describe_choices_is_one_line(tmp_path, monkeypatch):
     monkeypatch.setenv("TAILBEAM_CACHE_DIR", str(tmp_path))
     s = scene(plate="fmax = 3000.0\nmesh_divisions = 8")
-    res = auto.simulate_scene_modal(s)
-    line = auto.describe_choices(res.info)
+    res = single_ball.simulate_scene_modal(s)
+    line = setup.describe_choices(res.info)
     assert "\n" not in line
     assert line.startswith("band 0-3.0 kHz (plate.fmax set in the scene)")
-    assert f"{res.basis.n_modes} modes" in line and "8 divisions" in line
+    assert f"{res.plate.basis.n_modes} modes" in line and "8 divisions" in line
 
 
 STREAM = """
@@ -184,7 +187,7 @@ def _ball_at_plate(particle, speed) -> str:
 def test_stream_band_estimates_the_shortest_contact_as_a_single_ball_would():
     """A stream's band carries the same estimate as choose_band's for the particle with the
     shortest contact (not a placeholder), and the run says when the band is too low."""
-    from tailbeam.simulation import _band_warning, stream_band
+    from tailbeam.solvers.modal_setup.band import _band_warning, stream_band
 
     head = SCENE.split("[[balls]]")[0].format(plate="fmax = 10000.0")
     for incl in (0.0, 30.0):

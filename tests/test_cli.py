@@ -10,8 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tailbeam.io.results_io import IMPACT_COLUMNS
-from tailbeam.results.result import IMPACT_TABLE_COLUMNS
+from tailbeam.results.result import IMPACT_COLUMNS, IMPACT_TABLE_COLUMNS
 
 ROOT = Path(__file__).parents[1]
 EXAMPLE = ROOT / "examples" / "two_balls_rigid.toml"

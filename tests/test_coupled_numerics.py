@@ -105,7 +105,7 @@ def _impact(steps, residual=True, fmax=10000.0, damping=800.0):
     # term is a post-processing of the same forces whose full-band 1 us samples resolve the
     # kinks of the piecewise-linear force (its in-band convergence: tests/test_coupled_fe.py)
     times = np.linspace(0, 1e-3, 1001)
-    acc = res.plate_sample(times, [SENSOR], quasi_static=False)["a"][0]
+    acc = res.plate.sample(times, [SENSOR], quasi_static=False)["a"][0]
     return np.array([imp.restitution, imp.peak_force, imp.t_end - imp.t_start]), acc
 
 
@@ -132,7 +132,7 @@ def test_stability_with_modes_to_50khz_and_near_zero_damping():
     res = simulate_coupled([ball], basis, [law], 0.02, damping_ratio=1e-7, gravity=0.0)
     assert len(res.impacts) == 1
     t_after = res.impacts[0].t_end
-    energy = res.plate_energy(np.linspace(t_after, 0.02, 50))
+    energy = res.plate.energy(np.linspace(t_after, 0.02, 50))
     assert np.all(np.isfinite(energy))
     assert np.max(np.abs(energy / energy[0] - 1)) < 1e-4
     loss = 0.5 * ball.mass * (2.0**2 - res.impacts[0].v_out ** 2)
@@ -195,7 +195,7 @@ def test_lateral_motion_and_leaving_the_plate():
     first = res.impacts_of("m")[0]
     x_hit = 0.5 * first.t_start
     # the contact point's plate deflection is what the ball saw: delta = 0 at contact start
-    w = res.plate_sample([first.t_start], [(x_hit, 0.0)])["w"][0, 0]
+    w = res.plate.sample([first.t_start], [(x_hit, 0.0)])["w"][0, 0]
     z = res.sample([first.t_start])["m"]["z"][0]
     assert z - R - w == pytest.approx(0.0, abs=1e-12)
     assert res.impacts_of("o") == [] and res.impacts_of("l") == []
@@ -211,21 +211,21 @@ def test_slow_chatter_comes_to_rest():
     law = ball_plate_law(COAL, R, CARBON_STEEL, damping=800.0)
     ball = Ball("b", COAL, R, (0.1, 0.05, R + 1e-3), (0.0, 0.0, 0.0))
     res = simulate_coupled([ball], basis, [law], 1.0, damping_ratio=0.05)
-    t_rest = res.rest_time["b"]
+    t_rest = res.states.rest_time["b"]
     assert 0.0 < t_rest < 0.9 and res.impacts_of("b")[-1].ends_at_rest
     # no contact was missed: outside the located contacts the ball never overlaps the plate
     t = np.linspace(0.0, t_rest, 200001)
     inside = np.zeros(t.shape, dtype=bool)
     for imp in res.impacts_of("b"):
         inside |= (t >= imp.t_start) & (t <= imp.t_end)
-    gap = res.sample(t)["b"]["z"] - R - res.plate_sample(t, [(0.1, 0.05)])["w"][0]
+    gap = res.sample(t)["b"]["z"] - R - res.plate.sample(t, [(0.1, 0.05)])["w"][0]
     assert len(res.impacts_of("b")) > 5 and np.min(gap[~inside]) > -1e-12
     # the kept modes carry m g sum phi^2/omega^2; the truncated modes' quasi-static part adds
     # the rest of the full static deflection (residual flexibility is on)
-    w_end = res.plate_sample([1.0], [(0.1, 0.05)])
+    w_end = res.plate.sample([1.0], [(0.1, 0.05)])
     phi = basis.deflection([(0.1, 0.05)])[0]
     static_modal = -ball.mass * 9.80665 * np.sum(phi**2 / basis.omega**2)
-    kept = res.plate_sample([1.0], [(0.1, 0.05)], quasi_static=False)["w"][0, 0]
+    kept = res.plate.sample([1.0], [(0.1, 0.05)], quasi_static=False)["w"][0, 0]
     assert kept == pytest.approx(static_modal, rel=1e-3)
     static_full = -ball.mass * 9.80665 * basis.static_compliance_at([(0.1, 0.05)])[0]
     assert w_end["w"][0, 0] == pytest.approx(static_full, rel=1e-3)

@@ -11,10 +11,11 @@ from tailbeam.physics.materials import CARBON_STEEL, COAL, SANDSTONE
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
 from tailbeam.signals.sensor import SensorSpec
-from tailbeam.solvers.coupled import choose_band, simulate_coupled, simulate_scene_modal
-from tailbeam.solvers.coupled.auto import BAND_ACCURACY
+from tailbeam.solvers.coupled import simulate_coupled
 from tailbeam.solvers.coupled.zener import point_impedance, zener_impact
+from tailbeam.solvers.modal_setup.band import BAND_ACCURACY, choose_band
 from tailbeam.solvers.rigid import simulate_rigid
+from tailbeam.solvers.single_ball import simulate_scene_modal
 
 R = 0.03
 
@@ -33,8 +34,8 @@ def test_one_way_ignores_the_energy_the_plate_takes():
     assert one.impacts[0].restitution == pytest.approx(1.0, abs=1e-6)
     assert two.impacts[0].restitution == pytest.approx(zen.restitution, rel=2e-3)
     ke = 0.5 * ball.mass
-    e_one = one.plate_energy([1e-3])[0]
-    e_two = two.plate_energy([1e-3])[0]
+    e_one = one.plate.energy([1e-3])[0]
+    e_two = two.plate.energy([1e-3])[0]
     assert e_one > 0.3 * ke  # created from nothing: the ball lost none of it
     # c = 0: all the ball's loss is in the plate, up to the O(h^2) time-step error (2e-5 at the
     # default 200 steps per contact, see test_time_step_convergence_is_second_order)
@@ -62,7 +63,7 @@ def test_one_way_vs_two_way_restitution_peak_force_duration():
         assert a.peak_force < 0.95 * b.peak_force
         assert a.t_end - a.t_start > 1.02 * (b.t_end - b.t_start)
     # the one-way plate still answers the rigid forces: its sensor signal is not zero
-    acc = one.plate_sample(np.linspace(0.0, 0.05, 501), [(0.0, 0.1)])["a"][0]
+    acc = one.plate.sample(np.linspace(0.0, 0.05, 501), [(0.0, 0.1)])["a"][0]
     assert np.max(np.abs(acc)) > 1.0
 
 
@@ -99,7 +100,7 @@ def test_scene_runner_builds_the_fe_basis_and_the_sensors():
     res = simulate_scene_modal(scene, use_cache=False)
     assert res.info["basis"]["theory"] == "kirchhoff"
     assert res.info["basis"]["top_frequency_hz"] <= 3000.0
-    assert np.all(res.zeta == 0.02)
+    assert np.all(res.plate.zeta == 0.02)
     t, a = res.sensor_signals["s1"]
     assert len(t) == int(0.02 * 25600) + 1 and np.all(np.isfinite(a))
     assert np.max(np.abs(a)) > 0.0

@@ -1,5 +1,5 @@
 """``plate.tail = "ritz"``: the coupled solver with Ritz pseudo-modes at the balls' first
-contact points (tailbeam.solvers.coupled.ritz_prepass), against the full-FE reference of
+contact points (tailbeam.solvers.modal_setup.ritz_prepass), against the full-FE reference of
 tests/test_coupled_fe.py (same meshes, ball, sensor), plus the scene key and its bad input."""
 
 import math
@@ -10,18 +10,19 @@ from test_coupled_fe import IMPACT, MESHES, SENSOR, R, _basis, runs  # noqa: F40
 
 import tailbeam as tb
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.io.scene_file import dumps_scene, loads_scene, scene_to_dict
+from tailbeam.io.scene_dump import dumps_scene, scene_to_dict
+from tailbeam.io.scene_file import loads_scene
 from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.materials import SANDSTONE
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.scene import ContactSettings, ModalPlateSettings, Scene
-from tailbeam.solvers.coupled.auto import simulate_scene_modal
 from tailbeam.solvers.coupled.fe_compare import result_errors
-from tailbeam.solvers.coupled.ritz_prepass import (
+from tailbeam.solvers.modal_setup.ritz_prepass import (
     first_contact_time,
     first_contacts,
     ritz_tail_basis,
 )
+from tailbeam.solvers.single_ball import simulate_scene_modal
 
 BAND = 20000.0
 
@@ -75,7 +76,7 @@ def test_ritz_tail_scene_reaches_the_fe_reference_at_20_khz(runs, theory, tail_m
     tail = res.info["tail"]
     assert tail["model"] == "ritz" and tail["k"] == 32 and tail["added_modes"] == 32
     assert tail.get("k_per_point", [32]) == [32] and ("k_per_point" in tail) == bool(chosen)
-    assert res.basis.n_modes == basis.n_modes + 32
+    assert res.plate.basis.n_modes == basis.n_modes + 32
     assert tail["load_radii_m"] == [case.load_radius]
 
 
@@ -244,7 +245,7 @@ def test_auto_tail_keeps_the_quasi_static_tail_where_ritz_does_not_apply(capsys,
     basis = ssss_kirchhoff_basis(Plate(), BAND) if not modal else _basis("kirchhoff", fmax_hz=BAND)
     res = simulate_scene_modal(scene, basis=basis)
     assert res.info["tail"]["model"] == "quasi-static" and reason in res.info["tail"]["reason"]
-    assert res.basis.n_modes == basis.n_modes
+    assert res.plate.basis.n_modes == basis.n_modes
     assert f"tail: quasi-static ({res.info['tail']['reason']})" in capsys.readouterr().err
 
 
@@ -293,4 +294,4 @@ def test_auto_tail_builds_up_to_its_budget():
     basis = _basis("kirchhoff", fmax_hz=BAND)
     res = simulate_scene_modal(scene, basis=basis)
     assert res.info["tail"]["model"] == "ritz" and res.info["tail"]["added_modes"] == 128
-    assert res.basis.n_modes == basis.n_modes + 128
+    assert res.plate.basis.n_modes == basis.n_modes + 128

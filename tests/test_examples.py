@@ -23,7 +23,7 @@ def test_paper_reproduction_main():
     failed = [c.id for c in claims if not c.passed]
     assert not failed, failed
     # The equal-energy scene really has equal kinetic energies at t = 0 (before gravity acts).
-    coal, sand = results["energy"].balls
+    coal, sand = (p.ball() for p in results["energy"].particles)
     assert abs(coal.kinetic_energy / sand.kinetic_energy - 1.0) < 1e-12
 
 

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from tailbeam.errors import InputError
-from tailbeam.io.scene_file import dumps_scene, loads_scene
+from tailbeam.io.scene_dump import dumps_scene
+from tailbeam.io.scene_file import loads_scene
 from tailbeam.signals.noise import NoiseSpec, band_limited_noise, noise
 from tailbeam.signals.sensor import SensorSpec, measure
 

@@ -1,5 +1,5 @@
-"""Sparse load histories on the modal plate (tailbeam.solvers.plate_loads.loads / load_response) against
-independent truths: the dense exact replay (tailbeam.solvers.plate_loads.propagator), single-mode closed
+"""Sparse load histories on the modal plate (tailbeam.solvers.plate_loads) against independent
+truths: the dense exact replay (tailbeam.solvers.plate_loads.propagator), single-mode closed
 forms, the Navier / Timoshenko static deflection, and the coupled result's own sensor path."""
 
 import tracemalloc
@@ -12,8 +12,9 @@ from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.materials import SANDSTONE
 from tailbeam.plate import compute_modes
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.results.result import Result
 from tailbeam.signals.sensor import SensorSpec
-from tailbeam.solvers.coupled import CoupledResult
+from tailbeam.solvers.coupled.replay import ModalReplay
 from tailbeam.solvers.plate_loads.forced import forced_response
 from tailbeam.solvers.plate_loads.loads import PlateLoads
 from tailbeam.solvers.plate_loads.response import (
@@ -22,6 +23,7 @@ from tailbeam.solvers.plate_loads.response import (
     sensor_outputs,
     sensor_signals,
 )
+from tailbeam.streams.generator import balls_as_particles
 
 PLATE = Plate()
 DT = 2.0**-17  # s; dyadic, so grid times and their differences are exact
@@ -197,34 +199,35 @@ def test_dead_load_settles_to_the_static_deflection(basis):
 
 
 def coupled_result(basis, contact, t_nodes, forces, duration, sensors=()):
-    """A CoupledResult holding one ball's force nodes at ``contact`` (x, y) m, residual
-    flexibility on: its plate_sample / sensor_outputs are the existing dense exact path."""
+    """A single-ball result holding one ball's force nodes at ``contact`` (x, y) m, residual
+    flexibility on: its plate's replay and sensor outputs are the existing dense exact path."""
     tn = np.concatenate([[0.0], t_nodes, [duration]])
     fn = np.concatenate([[0.0], forces, [0.0]])[:, None]
     zeros = np.zeros_like(fn)
     phis = basis.deflection([contact])[None]
-    return CoupledResult(
-        balls=(Ball("s", SANDSTONE, 0.03, (*contact, 0.1), (0.0, 0.0, 0.0)),), laws=(None,),
-        basis=basis, duration=duration, gravity=9.81, zeta=np.full(basis.n_modes, 0.01),
-        impacts=[], events=[], rest_time={}, nodes=(tn, zeros, zeros, fn, zeros),
-        seg_phase=np.zeros(len(tn), dtype=np.int64), phis=phis, sensors=tuple(sensors),
-        contact_points=((t_nodes[0], 0, *contact, 0.0),), info={"residual_flexibility": True},
+    nodes = (tn, zeros, zeros, fn, zeros)
+    plate = ModalReplay(
+        basis, np.full(basis.n_modes, 0.01), nodes, np.zeros(len(tn), dtype=np.int64), phis,
+        ((t_nodes[0], 0, *contact, 0.0),), residual_flexibility=True,
     )  # fmt: skip
+    ball = Ball("s", SANDSTONE, 0.03, (*contact, 0.1), (0.0, 0.0, 0.0))
+    return Result(duration, balls_as_particles([ball]), [], [], sensors=tuple(sensors),
+                  plate=plate)  # fmt: skip
 
 
 def test_quasi_static_equals_the_coupled_result():
-    # the same force nodes as a CoupledResult (dense replay + its residual correction) and as
+    # the same force nodes as a single-ball result (dense replay + its residual correction) and as
     # a PlateLoads piece: the same kept-mode response and the same correction at the points
     basis = ssss_kirchhoff_basis(PLATE, 5000.0)
     tn, f = half_sine(2.1e-4, 3.1e-4, 2500.0, n=60)
     res = coupled_result(basis, (0.1, -0.05), tn, f, 1e-3)
-    assert res.has_quasi_static
+    assert res.plate.has_quasi_static
     loads = PlateLoads()
     loads.add_contact(0.1, -0.05, tn, f)
     times = np.arange(0, 1e-3, 1.0 / 102400)
-    ours = plate_response(basis, res.zeta, loads, POINTS, times)
-    ref = res.plate_sample(times, POINTS)
-    qs = res.quasi_static_sample(times, POINTS)
+    ours = plate_response(basis, res.plate.zeta, loads, POINTS, times)
+    ref = res.plate.sample(times, POINTS)
+    qs = res.plate.quasi_static_sample(times, POINTS)
     for key in "wva":
         assert rel_err(ours[key], ref[key]) < 1e-12, key
         assert np.max(np.abs(qs[key])) > 1e-4 * np.max(np.abs(ref[key]))  # not negligible
@@ -237,7 +240,7 @@ def test_sensor_outputs_equal_the_coupled_result_chain():
     res = coupled_result(basis, (0.1, -0.05), tn, f, 2e-3, sensors)
     loads = PlateLoads()
     loads.add_contact(0.1, -0.05, tn, f)
-    ours = sensor_outputs(basis, res.zeta, loads, sensors, 2e-3)
+    ours = sensor_outputs(basis, res.plate.zeta, loads, sensors, 2e-3)
     for name, (t, acc) in sensor_signals(ours).items():
         t_ref, acc_ref = res.sensor_signals[name]
         assert np.array_equal(t, t_ref)

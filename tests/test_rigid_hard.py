@@ -30,7 +30,7 @@ def _ball(v, gap=1e-3, name="A", x=0.0, vx=0.0):
 
 
 def _check_physical(res, law, gravity=G):
-    m = res.balls[0].mass
+    m = res.particles[0].mass
     for imp in res.impacts:
         for name in ("t_start", "v_in", "peak_force", "t_peak", "max_penetration"):
             assert math.isfinite(getattr(imp, name)), name
@@ -81,11 +81,11 @@ def test_undamped_bounces_conserve_energy():
 def test_very_large_damping_comes_to_rest_at_static_penetration():
     law = _law(c=1e6)
     res = simulate_rigid([_ball(1.0)], PLATE, [law], 0.1)
-    m = res.balls[0].mass
+    m = res.particles[0].mass
     assert len(res.impacts) == 1
     imp = res.impacts[0]
     assert imp.ends_at_rest and imp.v_out == 0.0 and math.isnan(imp.next_apex_height)
-    assert res.rest_time["A"] == imp.t_end < 0.1
+    assert res.states.rest_time["A"] == imp.t_end < 0.1
     assert res.events[-1].kind == "rest"
     delta_s = (m * G / law.stiffness) ** (1.0 / law.exponent)
     s = res.sample([imp.t_end, 0.1])["A"]
@@ -107,10 +107,10 @@ def test_persistent_contact_work_is_bounded():
     # and delta_1 = 2.5^(2/3) delta_s (m g delta_1 = k delta_1^2.5 / 2.5; the ramp damping is
     # tiny there) for the whole run
     res = simulate_rigid([Ball("A", COAL, R, (0, 0, R))], PLATE, [_law()], 0.05, rest_speed=0.0)
-    m = res.balls[0].mass
+    m = res.particles[0].mass
     delta_s = (m * G / K_COAL) ** (1 / 1.5)
     assert len(res.impacts) == 1 and math.isnan(res.impacts[0].v_out)
-    assert res.n_steps < 5000
+    assert res.stats["n_steps"] < 5000
     s = res.sample(np.linspace(0, 0.05, 20001))["A"]
     delta = R - s["z"]
     delta_1 = 2.5 ** (2.0 / 3.0) * delta_s
@@ -120,8 +120,8 @@ def test_persistent_contact_work_is_bounded():
 
 def test_ball_starting_at_rest_on_plate():
     res = simulate_rigid([Ball("A", COAL, R, (0, 0, R))], PLATE, [_law()], 0.1)
-    assert res.rest_time["A"] == 0.0
-    m = res.balls[0].mass
+    assert res.states.rest_time["A"] == 0.0
+    m = res.particles[0].mass
     s = res.sample([0.0, 0.05, 0.1])["A"]
     np.testing.assert_allclose(s["z"], R - (m * G / K_COAL) ** (1 / 1.5), rtol=1e-15)
     np.testing.assert_allclose(s["force"], m * G, rtol=1e-15)
@@ -172,7 +172,7 @@ def test_adams_clamp_versus_paper_equation_1():
         res = simulate_rigid([ball], PLATE, [law], 0.1, rtol=1e-12)
         imp = res.impacts[0]
         s = res.sample(np.linspace(imp.t_start, imp.t_end, 20001))["A"]
-        m = res.balls[0].mass
+        m = res.particles[0].mass
         lost = 0.5 * m * (imp.v_in**2 - imp.v_out**2)
         assert lost > 0.0
         assert _dissipated_by_damping(res, law, imp) == pytest.approx(lost, rel=1e-7)

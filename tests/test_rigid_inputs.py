@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from tailbeam import CARBON_STEEL, COAL, Ball, InputError, Plate, WorkLimitError, ball_plate_law
-from tailbeam.solvers.rigid import Impact, RigidResult, simulate_rigid
+from tailbeam.results.records import Impact
+from tailbeam.results.result import Result
+from tailbeam.solvers.rigid import simulate_rigid
 from tailbeam.solvers.rigid.reference import simulate_rigid_reference
 
 LAW = ball_plate_law(COAL, 0.03, CARBON_STEEL, damping=800.0, penetration=1e-4)
@@ -81,10 +83,10 @@ def test_max_steps_limit_message():
 
 def test_result_types_and_table():
     res = simulate_rigid([BALL], Plate(), [LAW], 0.5)
-    assert isinstance(res, RigidResult) and res.status == 0 and res.message
-    assert res.nfev > res.n_steps > 0
+    assert isinstance(res, Result) and res.status == 0 and res.message
+    assert res.stats["nfev"] > res.stats["n_steps"] > 0
     assert all(isinstance(i, Impact) for i in res.impacts)
-    row = res.table()[0]
+    row = res.impacts[0].as_dict()
     assert row["ball"] == "A" and row["index"] == 1 and isinstance(row["peak_force"], float)
     kinds = {e.kind for e in res.events}
     assert kinds <= {"contact_start", "full_damping", "clamp_on", "clamp_off", "contact_end"}

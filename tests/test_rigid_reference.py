@@ -121,7 +121,7 @@ def test_rest_rules_match_reference(damping, rule):
     assert [e.kind for e in fast.events] == [e.kind for e in ref.events]
     assert fast.events[-1].kind == "rest" and fast.impacts[-1].ends_at_rest
     assert (fast.impacts[-1].v_out == 0.0) == rule.startswith("B")
-    assert fast.rest_time["A"] == pytest.approx(ref.rest_time["A"], abs=1e-12)
+    assert fast.states.rest_time["A"] == pytest.approx(ref.states.rest_time["A"], abs=1e-12)
     for x, y in zip(fast.impacts, ref.impacts, strict=True):
         assert x.v_out == pytest.approx(y.v_out, rel=1e-9, abs=1e-12)
         assert x.peak_force == pytest.approx(y.peak_force, rel=1e-9)

@@ -6,7 +6,8 @@ from pathlib import Path
 import pytest
 
 from tailbeam.errors import InputError
-from tailbeam.io.scene_file import dumps_scene, load_scene, loads_scene, scene_to_dict
+from tailbeam.io.scene_dump import dumps_scene, scene_to_dict
+from tailbeam.io.scene_file import load_scene, loads_scene
 from tailbeam.physics.materials import COAL
 from tailbeam.scene import DEFAULT_DAMPING, DEFAULT_PENETRATION, ModalPlateSettings
 

@@ -98,7 +98,7 @@ def test_sensor_on_a_coupled_run_reads_the_plate_acceleration_in_band():
     res = simulate_coupled([ball], basis, [ball_plate_law(COAL, 0.03, CARBON_STEEL)], 0.05,
                            sensors=(spec,), gravity=0.0)  # fmt: skip
     t, measured = res.sensor_signals["s"]
-    true = res.true_acceleration(spec.position, t)
+    true = res.plate.acceleration(spec.position, t)
     sos = sp_signal.butter(8, 3000.0, fs=FS, output="sos")
     a, b = sp_signal.sosfiltfilt(sos, measured), sp_signal.sosfiltfilt(sos, true)
     err = np.sqrt(np.mean((a - b) ** 2) / np.mean(b**2))

@@ -190,8 +190,8 @@ def test_modal_plate_under_stream_loads_matches_the_one_way_solver():
         loads.add_contact(x, y, t, f)
     times = np.arange(2048) * (0.02 / 2048)
     point = np.array([[0.12, -0.08]])
-    want = one_way.plate_sample(times, point, quasi_static=False)["a"][0]
-    got = plate_response(basis, one_way.zeta, loads, point, times, quasi_static=False)["a"][0]
+    want = one_way.plate.sample(times, point, quasi_static=False)["a"][0]
+    got = plate_response(basis, one_way.plate.zeta, loads, point, times, quasi_static=False)["a"][0]
     assert np.linalg.norm(got - want) < 1e-4 * np.linalg.norm(want)
 
 

@@ -145,7 +145,8 @@ sample_rate = 8000.0
 
 def test_stream_scene_with_the_ritz_tail_says_what_it_chose(capsys):
     import tailbeam as tb
-    from tailbeam.io.scene_file import loads_scene, scene_to_dict
+    from tailbeam.io.scene_dump import scene_to_dict
+    from tailbeam.io.scene_file import loads_scene
 
     scene = loads_scene(SCENE.format(extra="tail_modes = 3"))
     result = tb.simulate(scene)

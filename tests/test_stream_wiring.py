@@ -19,20 +19,20 @@ import pytest
 import tailbeam
 from tailbeam.cli import main
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.io.scene_file import dumps_scene, load_scene, loads_scene, tomllib
+from tailbeam.io.scene_dump import dumps_scene
+from tailbeam.io.scene_file import load_scene, loads_scene, tomllib
 from tailbeam.physics.bodies import Plate
-from tailbeam.physics.contacts import LawOptions
 from tailbeam.physics.hertz import hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import COAL, SANDSTONE
+from tailbeam.results.result import (
+    IMPACT_COLUMNS,
+    IMPACT_TABLE_COLUMNS,
+    PARTICLE_COLUMNS,
+    Result,
+)
 from tailbeam.scene import Scene
 from tailbeam.solvers.rigid import simulate_rigid
-from tailbeam.solvers.stream.stream_result import (
-    IMPACT_COLUMNS,
-    PARTICLE_COLUMNS,
-    STREAM_IMPACT_COLUMNS,
-    StreamResult,
-)
 from tailbeam.streams.generator import generate_particles
 
 ROOT = Path(__file__).parents[1]
@@ -75,12 +75,12 @@ def small_result():
 
 
 def test_small_stream_impacts_csv_equals_the_result(small_cli, small_result):
-    assert isinstance(small_result, StreamResult)
+    assert isinstance(small_result, Result)
     header, rows = read_csv(small_cli / "impacts.csv")
-    assert tuple(header) == STREAM_IMPACT_COLUMNS
+    assert tuple(header) == IMPACT_TABLE_COLUMNS
     assert tuple(header[:12]) == IMPACT_COLUMNS  # today's columns first, in today's order
     table = small_result.impacts_table()
-    assert len(rows) == len(table["ball"]) == len(small_result.contacts)
+    assert len(rows) == len(table["ball"]) == len(small_result.impacts)
     for r, row in enumerate(rows):
         for c, name in enumerate(header):
             assert same_cell(row[c], table[name][r]), (r, name, row[c], table[name][r])
@@ -212,9 +212,9 @@ def test_simulate_refuses_what_it_cannot_run():
     ball = scene.balls[1]
     crowd = Scene((ball,), streams=scene.streams, duration=0.8)
     with pytest.MonkeyPatch.context() as mp:
-        import tailbeam.solvers.stream.solver as fast
+        from tailbeam.simulation import SOLVERS
 
-        mp.setattr(fast, "MAX_PARTICLES", 5)
+        mp.setattr(SOLVERS["stream"], "max_particles", 5)
         with pytest.raises(WorkLimitError, match=r"^streams\[1\].rate: .*at most 5"):
             tailbeam.simulate(crowd, progress=False)
 

@@ -12,9 +12,9 @@ pytest.importorskip("zarr")
 
 import xarray as xr  # noqa: E402
 
-from tailbeam.cli.simulate import solve  # noqa: E402
 from tailbeam.errors import InputError  # noqa: E402
 from tailbeam.io.scene_file import loads_scene  # noqa: E402
+from tailbeam.simulation import simulate as solve  # noqa: E402
 from tailbeam.study import dataset  # noqa: E402
 from tailbeam.study.case import run_case  # noqa: E402
 from tailbeam.study.design import expand, parse_sweep  # noqa: E402

@@ -17,8 +17,8 @@ import pandas as pd  # noqa: E402
 import xarray as xr  # noqa: E402
 
 from tailbeam.cli import main  # noqa: E402
-from tailbeam.cli.simulate import solve  # noqa: E402
 from tailbeam.io.scene_file import loads_scene  # noqa: E402
+from tailbeam.simulation import simulate as solve  # noqa: E402
 from tailbeam.study.windows import feature_table  # noqa: E402
 
 BASE = """

@@ -39,7 +39,7 @@ def clamp_summary(results, results_off, claims_off) -> str:
     """One line: claims holding without the clamp, largest change of first-impact restitution."""
     changes = []
     for key, result in results.items():
-        for ball in result.balls:
+        for ball in result.particles:
             on = result.impacts_of(ball.name)[0].restitution
             off = results_off[key].impacts_of(ball.name)[0].restitution
             changes.append(off - on)
@@ -82,7 +82,7 @@ def _write_scenarios(tmp, results) -> None:
     """Per scenario: impacts.csv, particles.csv, impacts.json, timeseries.csv and the
     figures."""
     from tailbeam.io.results_io import write_result_tables, write_timeseries_csv
-    from tailbeam.io.scene_file import scene_to_dict
+    from tailbeam.io.scene_dump import scene_to_dict
     from tailbeam.paper.figures import scenario_figures
     from tailbeam.paper.scenarios import SCENARIOS
 

@@ -1,6 +1,6 @@
 """`tailbeam simulate SCENE.toml [--out DIR] [--solver NAME]`: simulate a scene, write results.
 
---solver chooses the solver (``tailbeam.simulation.SOLVERS``; default auto), so one scene can
+--solver chooses the solver (``tailbeam.simulation.CHOICES``; default auto), so one scene can
 be run through two solvers and their impacts.csv compared.
 
 Writes impacts.csv (every column of ``Result.impacts_table``), particles.csv, impacts.json
@@ -35,17 +35,10 @@ def add_arguments(parser):
     )
 
 
-def solve(scene, solver="auto"):
-    """Run ``scene`` with ``solver`` (``tailbeam.simulate``; "auto" chooses from the scene)."""
-    from tailbeam import simulate
-
-    return simulate(scene, solver=solver)
-
-
 def write_results(out_dir, scene, result) -> list:
     """Write every output file of ``result`` into ``out_dir`` (an existing directory)."""
     from tailbeam.io.results_io import write_result_tables, write_timeseries_csv
-    from tailbeam.io.scene_file import scene_to_dict
+    from tailbeam.io.scene_dump import scene_to_dict
 
     files = write_result_tables(out_dir, result, scene_to_dict(scene))
     if result.keeps_states:
@@ -61,7 +54,7 @@ def write_results(out_dir, scene, result) -> list:
 
 def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
     from tailbeam.io.results_io import write_sensor_spectra_csv, write_sensors_csv
-    from tailbeam.paper.figures import sensor_figure
+    from tailbeam.signals.figures import sensor_figure
 
     meta = {
         s.name: {
@@ -92,16 +85,16 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
 
 def run(args) -> int:
     from tailbeam.io.scene_file import load_scene
-    from tailbeam.simulation import choose_solver
+    from tailbeam.simulation import choose_solver, simulate
 
     check_output_dir(args.out)
     scene = load_scene(args.scene)
     solver = choose_solver(scene, args.solver, "--solver")
-    if solver == "stream":
+    if solver.name == "stream":
         announce_first_compile("stream")
-    elif solver == "single-ball":
+    elif solver.name == "single-ball":
         announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
-    result = solve(scene, solver)
+    result = simulate(scene, solver=solver.name)
     with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:
         files = write_results(tmp, scene, result)
     n = len(result.impacts)

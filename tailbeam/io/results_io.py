@@ -12,8 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-# Column order of impacts.csv (the contract's first twelve columns, then the rest) and units.
-from tailbeam.results.result import (  # noqa: F401 - IMPACT_COLUMNS: imported from here by callers
+from tailbeam.results.result import (
     IMPACT_COLUMNS,
     IMPACT_TABLE_UNITS,
     IMPACT_UNITS,
@@ -100,8 +99,8 @@ def result_summary(result, scene_echo: dict | None = None) -> dict:
     rows = zip(*table.values(), strict=True)
     out["impacts"] = [dict(zip(table, row, strict=True)) for row in rows]
     out["leaves"] = [{"ball": e.ball, "time": e.time, "edge": e.edge} for e in result.leaves]
-    if hasattr(result, "rest_time"):
-        out["rest_time"] = dict(result.rest_time)
+    if result.states is not None:
+        out["rest_time"] = dict(result.states.rest_time)
     out["solver"] = {**result.stats, "status": result.status, "message": result.message}
     out["automatic_choices"] = _choices(result.info)
     return out

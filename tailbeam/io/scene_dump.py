@@ -7,7 +7,8 @@ sweep's provenance); ``dumps_scene`` its TOML text, with ``loads_scene(dumps_sce
 import math
 
 from tailbeam.physics.materials import BUILTIN_MATERIALS
-from tailbeam.scene import Scene, default_label
+from tailbeam.scene import Scene
+from tailbeam.streams.generator import default_label
 
 MATERIAL_KEYS = ("density", "youngs_modulus", "poisson_ratio")
 

@@ -20,7 +20,7 @@ from tailbeam.errors import (
 )
 
 # writing back lives in tailbeam.io.scene_dump; re-exported so existing imports keep working
-from tailbeam.io.scene_dump import MATERIAL_KEYS, dumps_scene, scene_to_dict  # noqa: F401
+from tailbeam.io.scene_dump import MATERIAL_KEYS
 from tailbeam.physics.bodies import Ball, Plate, check_ball_above_plate
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import Material, get_material
@@ -31,9 +31,9 @@ from tailbeam.scene import (
     ModalPlateSettings,
     Scene,
     SensorSpec,
-    default_label,
 )
 from tailbeam.signals.noise import NoiseSpec
+from tailbeam.streams.generator import default_label
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -287,7 +287,9 @@ def _parse_streams(value, incline: InclinedPlate, materials: dict) -> tuple:
     tables = _array_of_tables("streams", value)
     if not tables:
         return ()
-    from tailbeam.streams.generator import parse_stream  # scipy.special: only for streams
+    from tailbeam.streams.generator import (  # scipy.special: only for streams
+        parse_stream,
+    )
 
     return tuple(parse_stream(t, i, incline, materials) for i, t in enumerate(tables, start=1))
 

@@ -1,8 +1,9 @@
 """The paper's qualitative claims (sections 4.1-4.3, conclusions 1-3) as checkable functions.
 
-Each claim function takes the result of its scenario (a RigidResult, or anything with the same
-``impacts_of``, ``rest_time`` and ``duration``) and returns a ``Claim``: the paper's words (short
-paraphrase), the quantity compared, the numbers behind it, the threshold and whether it passed.
+Each claim function takes the result of its scenario (a ``tailbeam.Result`` of the rigid
+solver, or anything with the same ``impacts_of``, ``states.rest_time`` and ``duration``) and
+returns a ``Claim``: the paper's words (short paraphrase), the quantity compared, the numbers
+behind it, the threshold and whether it passed.
 Where the paper is ambiguous the docstring says how we read it. Collision numbers n are 1-based
 and only collisions inside the simulated time count; "after collision n" compares the two balls at
 the same n for every n both balls reach. Rebound height = the apex of the ball's lowest point

@@ -188,10 +188,10 @@ def claim_43_coal_varies_more(r) -> Claim:
 
 def claim_43_coal_rests_first(r) -> Claim:
     """After repeated collisions coal reaches static equilibrium first: coal is declared at rest
-    (the solver's definition, RigidResult.rest_time) inside the simulated time, and before
+    (the solver's definition, ``Result.states.rest_time``) inside the simulated time, and before
     sandstone (which may still be bouncing at the end)."""
-    tc = r.rest_time.get("coal", math.nan)
-    ts = r.rest_time.get("sandstone", math.nan)
+    tc = r.states.rest_time.get("coal", math.nan)
+    ts = r.states.rest_time.get("sandstone", math.nan)
     ok = math.isfinite(tc) and (not math.isfinite(ts) or tc < ts)
     return Claim(
         "4.3-coal-rests-first",

@@ -14,8 +14,6 @@ from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from tailbeam.signals.figures import sensor_figure, sensor_figures  # noqa: F401 (re-exported)
-
 # The paper's figure numbers: (position, velocity, force) per scenario.
 PAPER_FIGURES = {"velocity": (2, 3, 4), "material": (5, 6, 7), "energy": (8, 9, 10)}
 QUANTITIES = (
@@ -57,7 +55,7 @@ def plot_grid(result, sample_rate: float) -> np.ndarray:
 def _ball_order(result) -> list:
     """(index, name) of the balls, the one with the largest peak force first: drawn first, so
     the smaller pulses lie on top of the larger ones."""
-    names = [b.name for b in result.balls]
+    names = [b.name for b in result.particles]
 
     def peak(name):
         return max((imp.peak_force for imp in result.impacts_of(name)), default=0.0)
@@ -67,7 +65,7 @@ def _ball_order(result) -> list:
 
 def _zoom_window(result) -> tuple:
     """[t0, t1] (s) holding the first contact of every ball, padded by a fifth of the longest."""
-    firsts = [imps[0] for b in result.balls if (imps := result.impacts_of(b.name))]
+    firsts = [imps[0] for b in result.particles if (imps := result.impacts_of(b.name))]
     if not firsts:
         return None
     t0 = min(imp.t_start for imp in firsts)
@@ -95,7 +93,7 @@ def force_figure(result, scenario, t, states, number) -> Figure:
     _force_axes(ax, result, t, states)
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("contact force (N)")
-    marked = all(len(result.impacts_of(b.name)) <= MAX_MARKED_IMPACTS for b in result.balls)
+    marked = all(len(result.impacts_of(b.name)) <= MAX_MARKED_IMPACTS for b in result.particles)
     note = "markers: peaks of impacts.csv" if marked else f"peaks: collisions_{scenario.key}.png"
     ax.set_title(f"whole record; {note}", fontsize=9)
     handles = [
@@ -107,7 +105,7 @@ def force_figure(result, scenario, t, states, number) -> Figure:
             mfc="none",
             label=n,
         )
-        for i, n in enumerate(b.name for b in result.balls)
+        for i, n in enumerate(b.name for b in result.particles)
     ]
     ax.legend(handles=handles, loc="upper right")
     window = _zoom_window(result)
@@ -142,13 +140,13 @@ def time_figure(result, scenario, t, states, key, label, number) -> Figure:
     ax.set_xlabel("time t (s)")
     ax.set_ylabel(label)
     title = _title(scenario, number)
-    if max(len(result.impacts_of(b.name)) for b in result.balls) > MAX_MARKED_IMPACTS:
+    if max(len(result.impacts_of(b.name)) for b in result.particles) > MAX_MARKED_IMPACTS:
         title += (
             f"\nper collision: collisions_{scenario.key}.png; one pulse: pulse_{scenario.key}.png"
         )
     ax.set_title(title, fontsize=9)
     handles, names = ax.get_legend_handles_labels()
-    order = np.argsort([[b.name for b in result.balls].index(n) for n in names])
+    order = np.argsort([[b.name for b in result.particles].index(n) for n in names])
     ax.legend(  # outside the axes: the curves fill the whole record
         [handles[k] for k in order],
         [names[k] for k in order],
@@ -180,9 +178,9 @@ def collision_figure(result, scenario) -> Figure:
     the quantities the paper's claims compare collision by collision (impacts.csv)."""
     fig = Figure(figsize=(11.0, 3.6), layout="constrained")
     axes = fig.subplots(1, len(COLLISION_PANELS))
-    n_max = max((len(result.impacts_of(b.name)) for b in result.balls), default=0)
+    n_max = max((len(result.impacts_of(b.name)) for b in result.particles), default=0)
     for ax, (field, label, scale) in zip(axes, COLLISION_PANELS, strict=True):
-        for i, name in enumerate(b.name for b in result.balls):
+        for i, name in enumerate(b.name for b in result.particles):
             n, y = collision_series(result, name, field)
             style = {"marker": MARKERS[i % len(MARKERS)], "ms": 4 if n_max <= 60 else 2}
             ax.plot(n, y * scale, lw=0.8, color=_colour(i), label=name, **style)
@@ -204,7 +202,7 @@ def first_pulses(result) -> dict:
     """name -> (time since contact start (s), penetration (m), force (N)) over the ball's
     first contact, sampled from the stored solution."""
     out = {}
-    for ball in result.balls:
+    for ball in result.particles:
         imps = result.impacts_of(ball.name)
         if not imps:
             continue
@@ -222,7 +220,7 @@ def pulse_figure(result, scenario) -> Figure:
     fig = Figure(figsize=(10.0, 3.8), layout="constrained")
     ax_t, ax_d = fig.subplots(1, 2)
     pulses = first_pulses(result)
-    for i, name in enumerate(b.name for b in result.balls):
+    for i, name in enumerate(b.name for b in result.particles):
         if name not in pulses:
             continue
         tau, delta, force = pulses[name]

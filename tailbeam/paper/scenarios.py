@@ -136,7 +136,7 @@ def run_scenario(
     solver=None,
     **solver_options,
 ):
-    """Simulate built-in scenario ``key`` on the rigid plate; returns the solver's RigidResult.
+    """Simulate built-in scenario ``key`` on the rigid plate; returns its ``tailbeam.Result``.
 
     ``solver``: a function with the signature of ``tailbeam.solvers.rigid.simulate_rigid``
     (default), e.g. ``tailbeam.solvers.rigid.reference.simulate_rigid_reference``.
@@ -149,5 +149,5 @@ def run_scenario(
 
 
 def run_all(contact: ContactSettings | None = None, *, drop_gap: float = DROP_GAP, **options):
-    """Run the three built-in scenarios; returns {scenario key: RigidResult}."""
+    """Run the three built-in scenarios; returns {scenario key: Result}."""
     return {key: run_scenario(key, contact, drop_gap=drop_gap, **options) for key in SCENARIOS}

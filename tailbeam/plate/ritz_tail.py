@@ -16,7 +16,7 @@ point brings the contact quantities of the test meshes to 2-7e-6 of the full FE 
 (quasi-static residual 3.5e-5), k = 48-128 on the default Argyris 23x23 mesh. This module only
 builds them for load points known in advance (``with_ritz_tail``: the FE cross-checks, and
 the coupled solver's pre-pass over the balls' first contact points with ``plate.tail =
-"ritz"``, tailbeam.solvers.coupled.ritz_prepass).
+"ritz"``, tailbeam.solvers.modal_setup.ritz_prepass).
 """
 
 import numpy as np

@@ -25,8 +25,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import fft as sp_fft
-from scipy import signal
 
 from tailbeam.errors import InputError, require_positive, require_vector
 from tailbeam.signals.noise import NoiseSpec, noise
@@ -131,6 +129,8 @@ def mounted_resonance(chain: SensorChain, freq_hz) -> np.ndarray:
 def _apply_resonance(chain: SensorChain, a_fine: np.ndarray) -> np.ndarray:
     """The resonance applied exactly in the frequency domain. The record starts from rest and is
     zero-padded by 20 decay times 1/(zr wr), so the circular convolution is the linear one."""
+    from scipy import fft as sp_fft  # (scipy.signal: loaded only when a sensor is measured)
+
     wr = 2 * math.pi * chain.mounted_resonance_hz
     pad = int(math.ceil(20.0 / (chain.resonance_damping * wr) * chain.fine_rate))
     n_fft = sp_fft.next_fast_len(len(a_fine) + pad, real=True)
@@ -141,6 +141,8 @@ def _apply_resonance(chain: SensorChain, a_fine: np.ndarray) -> np.ndarray:
 
 def anti_alias_fir(chain: SensorChain) -> np.ndarray:
     """Linear-phase FIR taps on the fine grid; length 2 m oversample + 1 (delay m samples)."""
+    from scipy import signal  # (scipy.signal: loaded only when a sensor is measured)
+
     fine = chain.fine_rate
     f_pass = chain.bandwidth_hz
     f_stop = chain.sample_rate - chain.bandwidth_hz
@@ -158,6 +160,8 @@ def amplitude_spectrum(x, sample_rate: float, *, window: str = "boxcar"):
     A sinusoid of amplitude A on a bin shows as A. The default rectangular window suits impact
     transients recorded whole; a window (e.g. "hann") is corrected for its coherent gain.
     """
+    from scipy import signal  # (scipy.signal: loaded only when a sensor is measured)
+
     x = np.asarray(x, dtype=float)
     n = len(x)
     if n < 2:
@@ -179,6 +183,8 @@ def measure(
 ) -> SensorOutput:
     """Run the chain on the true plate acceleration (a function of time in s) over
     [0, duration] s; the plate is at rest before t = 0."""
+    from scipy import signal  # (scipy.signal: loaded only when a sensor is measured)
+
     chain = resolve(spec, max_frequency_hz)
     taps = anti_alias_fir(chain)
     delay = (len(taps) - 1) // 2  # fine samples, a multiple of oversample
@@ -197,6 +203,8 @@ def measure(
 
 def chain_response(chain: SensorChain, freq_hz) -> np.ndarray:
     """Complex response of the sensor chain (resonance x anti-alias FIR, delay removed)."""
+    from scipy import signal  # (scipy.signal: loaded only when a sensor is measured)
+
     f = np.asarray(freq_hz, dtype=float)
     h_res = mounted_resonance(chain, f)
     taps = anti_alias_fir(chain)

@@ -112,6 +112,24 @@ class Particle:
         """The particle as a ``tailbeam.Ball`` at its release state."""
         return Ball(self.name, self.material, self.radius, self.position, self.velocity)
 
+    @classmethod
+    def from_ball(cls, ball: Ball, label: str) -> "Particle":
+        """A ``[[balls]]`` entry as a particle: no stream, released at 0 s, labelled ``label``."""
+        return cls(ball.name, "", label, ball.material, ball.radius, ball.mass, 0.0,
+                   ball.position, ball.velocity)  # fmt: skip
+
+
+def default_label(ball: Ball) -> str:
+    """``coal`` for a ball of the material named coal, ``gangue`` otherwise."""
+    return "coal" if ball.material.name == "coal" else "gangue"
+
+
+def balls_as_particles(balls, labels=()) -> tuple:
+    """``[[balls]]`` as ``Particle``s (``Particle.from_ball``), labelled ``labels`` (coal /
+    gangue per ball; empty: ``default_label``)."""
+    labels = tuple(labels) or tuple(default_label(b) for b in balls)
+    return tuple(Particle.from_ball(b, label) for b, label in zip(balls, labels, strict=True))
+
 
 def parse_stream(settings: dict, index: int, incline: InclinedPlate, materials=None):
     """Validate the settings of stream number ``index`` (1-based, as the user counts)."""

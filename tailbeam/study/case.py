@@ -40,11 +40,10 @@ def basis_signature(scene) -> str:
 
 
 def _band(scene) -> dict:
-    """The band the scene's solver will use: a stream scene's (tailbeam.simulation), else
+    """The band the scene's solver will use: a stream scene's (``stream_band``), else
     the scene's plate.fmax when set (then the contact pulses choose_band also estimates,
     ~5 ms per case, are not needed here), else choose_band's."""
-    from tailbeam.simulation import stream_band
-    from tailbeam.solvers.coupled.auto import choose_band
+    from tailbeam.solvers.modal_setup.band import choose_band, stream_band
 
     if scene.needs_stream_solver:
         return stream_band(scene)
@@ -57,8 +56,8 @@ def warm_basis(scene_toml: str) -> str:
     """Compute (or load) the modal basis of the scene into the on-disk cache; returns the
     basis description. Runs once per basis_signature before the sweep's cases."""
     from tailbeam.io.scene_file import loads_scene
-    from tailbeam.simulation import stream_band, tail_basis
-    from tailbeam.solvers.coupled.auto import build_basis
+    from tailbeam.solvers.modal_setup.band import stream_band
+    from tailbeam.solvers.modal_setup.setup import build_basis, tail_basis
 
     try:
         scene = loads_scene(scene_toml)
@@ -93,7 +92,7 @@ def _impact_rows(result) -> list:
 
 def _band_columns(result) -> dict:
     """The modal band a case ran with (Hz) and the band check's upper estimate of its
-    peak-force error (tailbeam.solvers.coupled.auto: for a stream, at its hardest plate
+    peak-force error (tailbeam.solvers.modal_setup.band: for a stream, at its hardest plate
     contact); none on the rigid plate (the dataset then records NaN)."""
     band = result.info.get("band") or {}
     if "fmax_hz" not in band:
@@ -121,8 +120,8 @@ def run_case(scene_toml: str, *_after) -> dict:
     modal plate "band_hz" and "band_force_error" (``_band_columns``)}.
     ``_after`` are ignored (Dask dependencies, e.g. the warmed basis; callers before the
     labels moved into the scene passed the coal materials here)."""
-    from tailbeam.cli.simulate import solve
     from tailbeam.io.scene_file import loads_scene
+    from tailbeam.simulation import simulate
 
     t0 = time.perf_counter()
     c0 = time.process_time()
@@ -132,17 +131,17 @@ def run_case(scene_toml: str, *_after) -> dict:
         with quiet():  # the sweep's own bar reports progress; per-case notes would flood it
             scene = loads_scene(scene_toml)
             stream = scene.needs_stream_solver
-            result = solve(scene)
-        if result.status != 0:
-            out["error"] = f"solver stopped: {result.message}".splitlines()[0]
-        else:
-            out["signals"] = {
-                name: np.asarray(a, dtype=np.float32)
-                for name, (_t, a) in result.sensor_signals.items()
-            }
-            out["impacts"] = _impact_rows(result)
-            out.update(_band_columns(result))
-            out["status"] = "ok"
+            result = simulate(scene)
+            if result.status != 0:
+                out["error"] = f"solver stopped: {result.message}".splitlines()[0]
+            else:
+                out["signals"] = {
+                    name: np.asarray(a, dtype=np.float32)
+                    for name, (_t, a) in result.sensor_signals.items()
+                }
+                out["impacts"] = _impact_rows(result)
+                out.update(_band_columns(result))
+                out["status"] = "ok"
     except Exception as err:  # noqa: BLE001 - any failure is recorded, never raised
         out["error"] = _one_line(err) or traceback.format_exc().splitlines()[-1]
     out.update(_counts(out["impacts"], stream))

@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from tailbeam.errors import InputError
-from tailbeam.io.scene_file import dumps_scene, parse_scene
+from tailbeam.io.scene_dump import dumps_scene
+from tailbeam.io.scene_file import parse_scene
 from tailbeam.study.case import basis_signature
 from tailbeam.study.labels import case_labels, label_balls, stream_labels
 from tailbeam.study.scene_keys import set_value

@@ -29,8 +29,9 @@ def case_labels(scene) -> dict:
 def label_balls(data: dict, coal: tuple) -> None:
     """Give every ``[[balls]]`` table of the raw scene ``data`` that has no ``label`` the
     label of its material: coal if it is in ``coal``, else gangue (in place). The scene
-    TOML then carries it where it differs from the default (tailbeam.scene.default_label),
-    and every output (impacts.csv's ``label``) agrees with the sweep's labels."""
+    TOML then carries it where it differs from the default
+    (tailbeam.streams.generator.default_label), and every output (impacts.csv's ``label``)
+    agrees with the sweep's labels."""
     balls = data.get("balls")
     for ball in balls if isinstance(balls, list) else []:
         if isinstance(ball, dict) and "label" not in ball and isinstance(ball.get("material"), str):

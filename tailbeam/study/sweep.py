@@ -181,9 +181,9 @@ def _submit(client, todo: list) -> dict:
 
 
 def _band_note(toml: str) -> None:
-    """The stream band check (tailbeam.simulation.check_stream_band) of a basis group's first
+    """The stream band check (``tailbeam.solvers.modal_setup.band.check_stream_band``) of a basis group's first
     case, said once: the cases themselves run quietly."""
-    from tailbeam.simulation import check_stream_band, stream_band
+    from tailbeam.solvers.modal_setup.band import check_stream_band, stream_band
 
     scene = loads_scene(toml)
     if scene.needs_stream_solver and scene.plate_model == "modal":

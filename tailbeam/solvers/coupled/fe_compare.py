@@ -70,7 +70,7 @@ def result_errors(case: Case, res, ref) -> dict:
     a_ref = in_band(t, ref.sensor_a[0], SENSOR_BAND_HZ)
     win = t <= SENSOR_WINDOW_S
     for key, qs in (("sensor", True), ("sensor_no_qs", False)):
-        a = res.plate_sample(t, [case.sensor], quasi_static=qs)["a"][0]
+        a = res.plate.sample(t, [case.sensor], quasi_static=qs)["a"][0]
         out[key] = relative_l2(in_band(t, a, SENSOR_BAND_HZ)[win], a_ref[win])
     return out
 

@@ -301,8 +301,8 @@ def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kin
             hit = _locate(EventCode.CONTACT_START, b, lo, flo, hi, fhi, ctx, st, out2, g, d, guess)
             if hit < 0.0:
                 return False, best, kind_best, b_best
-            best, kind_best, b_best = _keep(hit, EventCode.CONTACT_START, b, best, kind_best, b_best, out2,
-                                            out_best)  # fmt: skip
+            best, kind_best, b_best = _keep(hit, EventCode.CONTACT_START, b, best, kind_best,
+                                            b_best, out2, out_best)  # fmt: skip
     return True, best, kind_best, b_best
 
 
@@ -403,7 +403,7 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
         for b in range(nb):
             nk = _contact_kinds(b, mode, deep, aux, d, clampf, kinds)
             if nk == 0 and mode[b] != FLIGHT:
-                continue  # (nothing to locate: no tuples handed over, see tailbeam.solvers.numerics.jit)
+                continue  # (nothing to locate: no tuples handed over, see numerics.jit)
             ok, best, kind_best, b_best = _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L,
                                                        A, guess, best, kind_best, b_best, mode,
                                                        cur, d, kinds, nk)  # fmt: skip

@@ -16,7 +16,9 @@ import numpy as np
 from tailbeam.physics.bodies import STANDARD_GRAVITY
 from tailbeam.physics.contact_patch import load_radius
 from tailbeam.physics.contacts import PLATE, contact_table
-from tailbeam.solvers.coupled.result import CoupledResult
+from tailbeam.plate.basis import modal_damping
+from tailbeam.results.result import Result
+from tailbeam.solvers.coupled.replay import ModalReplay, NodeStates
 from tailbeam.solvers.rigid import simulate_rigid
 
 
@@ -32,22 +34,22 @@ def simulate_one_way(
     rest_speed=None,
     gravity=STANDARD_GRAVITY,
     points_per_contact: int = 400,
-) -> CoupledResult:
+    labels=(),
+    info=None,
+) -> Result:
     """Rigid-plate impacts (tailbeam.solvers.rigid) whose force histories drive the modal plate;
     ``laws``: the balls' ``ContactTable`` or one ball-plate ImpactLaw per ball."""
-    from tailbeam.plate.basis import modal_damping
-
     kwargs = {} if rest_speed is None else {"rest_speed": rest_speed}
     if gravity != STANDARD_GRAVITY:
         kwargs["gravity"] = gravity
     contacts = contact_table(balls, laws)
-    rigid = simulate_rigid(balls, basis.plate, contacts, duration, **kwargs)
+    rigid = simulate_rigid(balls, basis.plate, contacts, duration, labels=labels, **kwargs)
     # node times: fine inside every contact, the contact limits, rest times, and the ends
     pieces = [np.array([0.0, duration])]
     for imp in rigid.impacts:
         t_end = min(imp.t_end, duration)
         pieces.append(np.linspace(imp.t_start, t_end, points_per_contact + 1))
-    for t_rest in rigid.rest_time.values():
+    for t_rest in rigid.states.rest_time.values():
         if np.isfinite(t_rest):
             pieces.append(np.array([t_rest]))
     tn = np.unique(np.concatenate(pieces))
@@ -64,23 +66,15 @@ def simulate_one_way(
     ]
     phi = np.array([basis.load_deflection([balls[i].position[:2]], radii[i])[0]
                     for i in range(len(balls))])  # fmt: skip
-    omega = np.asarray(basis.omega)
-    return CoupledResult(
-        balls=tuple(balls),
-        laws=contacts.plate_laws(),
-        basis=basis,
-        duration=duration,
-        gravity=rigid.gravity,
-        zeta=modal_damping(omega, damping_ratio, rayleigh),
-        impacts=list(rigid.impacts),
-        events=list(rigid.events),
-        rest_time=dict(rigid.rest_time),
-        nodes=(tn, z, vz, force, delta),
-        seg_phase=np.zeros(len(tn), dtype=np.int64),
-        phis=np.ascontiguousarray(phi[None, :, :]),
+    nodes = (tn, z, vz, force, delta)
+    zeta = modal_damping(np.asarray(basis.omega), damping_ratio, rayleigh)
+    phis = np.ascontiguousarray(phi[None, :, :])
+    seg_phase = np.zeros(len(tn), dtype=np.int64)
+    return Result(
+        duration=rigid.duration, particles=rigid.particles, impacts=rigid.impacts,
+        events=rigid.events, leaves=rigid.leaves, status=rigid.status, message=rigid.message,
+        stats=rigid.stats, info={"coupling": "one-way", "rigid": rigid.info, **(info or {})},
         sensors=tuple(sensors),
-        n_steps=rigid.n_steps,
-        status=rigid.status,
-        message=rigid.message,
-        info={"coupling": "one-way", "rigid": rigid},
-    )
+        states=NodeStates(tuple(balls), gravity, nodes, dict(rigid.states.rest_time)),
+        plate=ModalReplay(basis, zeta, nodes, seg_phase, phis),
+    )  # fmt: skip

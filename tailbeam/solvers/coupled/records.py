@@ -1,10 +1,39 @@
-"""The Impact record of a finished contact of the coupled driver."""
+"""The coupled driver's records: the contacts in progress, the events, the Impact record of
+each finished contact (``close_contact``) and when each ball came to rest."""
 
 import math
 
 import numpy as np
 
-from tailbeam.results.records import Impact
+from tailbeam.results.records import PLATE, Event, EventKind, Impact
+
+
+class ContactBook:
+    """The records of a run of ``balls`` (their names): ``events`` and ``impacts`` (both
+    ``tailbeam.results.records``), the contacts in progress by ball (``open``: index, start
+    time s, v_in m/s, first node, time limit s), each contact's point (``contact_points``:
+    t_start s, ball, x m, y m, load radius m) and each ball's rest time (s, nan if none)."""
+
+    def __init__(self, balls):
+        self.balls = balls
+        self.events, self.impacts, self.open, self.contact_points = [], [], {}, []
+        self.counts = [0] * len(balls)
+        self.rest_time = {b.name: math.nan for b in balls}
+
+    def event(self, t: float, b: int, kind: EventKind) -> None:
+        self.events.append(Event(t, self.balls[b].name, kind, PLATE))
+
+    def start(self, b: int, t: float, point: tuple, v_in: float, node: int, t_limit: float):
+        """Ball b's contact starts at t (s) at ``point`` (x m, y m, load radius m)."""
+        self.contact_points.append((t, b, *point))
+        self.counts[b] += 1
+        self.open[b] = {"index": self.counts[b], "t_start": t, "v_in": v_in, "node": node,
+                        "t_limit": t_limit}  # fmt: skip
+
+    def rest(self, b: int, t: float) -> None:
+        """Ball b came to rest at t (s)."""
+        self.rest_time[self.balls[b].name] = t
+        self.event(t, b, EventKind.REST)
 
 
 def close_contact(info, b, ball, t_end, v_out, bufs, nbuf, radius, gravity, *, at_rest, z=math.nan):

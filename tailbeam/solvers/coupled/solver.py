@@ -9,8 +9,9 @@ from tailbeam.errors import InputError, require_positive
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, check_ball_above_plate
 from tailbeam.physics.contacts import contact_table
 from tailbeam.plate.basis import DEFAULT_DAMPING_RATIO, ModalBasis, modal_damping
+from tailbeam.results.result import Result
 from tailbeam.solvers.coupled.driver import CoupledRun
-from tailbeam.solvers.coupled.result import CoupledResult
+from tailbeam.solvers.coupled.oneway import simulate_one_way
 
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid solver's value, so both models stop alike
 DEFAULT_STEPS_PER_CONTACT = 200  # steps per Hertz contact duration: ~1e-5 relative error
@@ -33,7 +34,9 @@ def simulate_coupled(
     gravity: float = STANDARD_GRAVITY,
     max_steps: int = 5_000_000,
     max_events: int = 200_000,
-) -> CoupledResult:
+    labels=(),
+    info=None,
+) -> Result:
     """Balls striking the modal plate ``basis`` over [0, duration] s; see the package docstring.
 
     laws: the balls' ``ContactTable`` (``Scene.contacts()``, tailbeam.physics.contacts) or
@@ -42,15 +45,15 @@ def simulate_coupled(
     compliance of the truncated modes in series with each contact. steps_per_contact: steps per
     Hertz contact duration (accuracy, 2nd order). A ball whose rebound is slower than
     ``rest_speed`` (m/s), or that stays in contact longer than rest_contact_factor Hertz
-    durations, is declared at rest and then loads the plate with its weight.
+    durations, is declared at rest and then loads the plate with its weight. labels: coal /
+    gangue per ball (empty: from the material); info: more entries for ``Result.info``.
+    Returns a ``tailbeam.Result`` with the balls' states and the plate's replay.
     """
     balls = tuple(balls)
     laws = _check_inputs(balls, basis, laws, sensors, residual_flexibility, coupling,
                          steps_per_contact)  # fmt: skip
     duration = require_positive("duration", duration)
     if coupling == "one-way":
-        from tailbeam.solvers.coupled.oneway import simulate_one_way
-
         return simulate_one_way(
             balls,
             basis,
@@ -61,6 +64,8 @@ def simulate_coupled(
             rayleigh=rayleigh,
             rest_speed=rest_speed,
             gravity=gravity,
+            labels=labels,
+            info=info,
         )
     run = CoupledRun(
         balls,
@@ -74,6 +79,8 @@ def simulate_coupled(
         rest_speed=rest_speed,
         rest_contact_factor=rest_contact_factor,
         gravity=gravity,
+        labels=labels,
+        info=info,
     )
     return run.solve(max_steps, max_events)
 

@@ -1,9 +1,9 @@
-"""Closed-form motion between contacts, and when it ends: pure helpers of the stream driver.
+"""Closed-form motion between contacts, and when it ends: pure helpers of the solvers.
 
 A ball that touches nothing moves with a constant acceleration a (m/s^2) in the plate frame:
 
 * flying: a = g_vec = g (sin theta, 0, -cos theta);
-* sliding (resting quasi-statically on the frictionless plate, ``tailbeam.solvers.stream.driver.loop``):
+* sliding (resting quasi-statically on the frictionless plate, the stream driver's sliders):
   a = (g sin theta, 0, 0), its height held at the static penetration.
 
 so x(tau) = x0 + v0 tau + a tau^2 / 2. The times at which such motion ends are roots of
@@ -25,6 +25,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from tailbeam.physics.incline import EDGES
+from tailbeam.results.records import LeaveEvent
 
 NEVER = math.inf
 
@@ -155,3 +156,25 @@ def pair_coefficients(dx, dv, da, radius_sum: float) -> np.ndarray:
 def pair_time(dx, dv, da, radius_sum: float, horizon: float) -> float:
     """Time (s) within ``horizon`` at which two balls in closed-form motion first touch."""
     return first_crossing(pair_coefficients(dx, dv, da, radius_sum), horizon)
+
+
+def lateral_leaves(balls, plate, duration: float) -> list:
+    """``LeaveEvent`` of every ball whose centre passes an edge of ``plate`` by ``duration`` s,
+    in time order, for balls moving laterally at their constant initial velocity (the
+    single-ball solvers: a horizontal frictionless plate); edges named as ``EDGES``."""
+    out = [_lateral_leave(b, plate, duration) for b in balls]
+    return sorted((e for e in out if e is not None), key=lambda e: e.time)
+
+
+def _lateral_leave(ball, plate, duration):
+    (x, y, _z), (vx, vy, _vz) = ball.position, ball.velocity
+    ha, hb = 0.5 * plate.size_x, 0.5 * plate.size_y
+    best = None
+    for edge, dist, rate in (
+        ("x-", x + ha, vx), ("x+", ha - x, -vx), ("y-", y + hb, vy), ("y+", hb - y, -vy)
+    ):  # fmt: skip
+        if rate < 0.0:
+            t = dist / -rate
+            if t <= duration and (best is None or t < best.time):
+                best = LeaveEvent(ball.name, t, edge)
+    return best

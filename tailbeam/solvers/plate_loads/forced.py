@@ -2,8 +2,8 @@
 
 Loads press down on the top surface (like a ball's contact force, N, >= 0 pushes -z); between
 the node times the load is linear in time and every mode is propagated exactly
-(``tailbeam.solvers.plate_loads.propagator.replay``). Used by the one-way coupling, the checks against
-direct time integration and by users who measure a force and want the plate's answer.
+(``tailbeam.solvers.plate_loads.propagator.replay``). Used by the one-way coupling, the checks
+against direct time integration and by users who measure a force and want the plate's answer.
 """
 
 import numpy as np

@@ -17,7 +17,7 @@ transition matrix P(tau) (closed form, zeta < 1). So:
 - ``add_particular``: per load, the particular part at the points over the samples the load
   acts on (its static-like part through the precomputed G = sum phi(P) phi_load/omega^2 and
   H = sum phi(P) phi_load 2 zeta/omega^3), and the truncated modes' quasi-static response
-  -R F(t) with the central differences of the sampled force (as CoupledResult does).
+  -R F(t) with the central differences of the sampled force (as ``ModalReplay`` does).
 
 A node belongs to the first sample at or after it (``target``); the particular part of a
 segment is used from its first node's target up to (not including) its last node's target,

@@ -6,7 +6,7 @@ forces (the closed-form propagation of ``tailbeam.solvers.plate_loads.propagator
 ``tailbeam.solvers.plate_loads.kernel``: a particular part that follows the force and a free
 homogeneous part that jumps at load nodes), so the result is exact at the samples whatever
 the node times. Optionally the truncated modes' quasi-static response is added at the points
-(as ``CoupledResult.quasi_static_sample``).
+(as ``tailbeam.solvers.coupled.replay.ModalReplay.quasi_static_sample``).
 
 Cost: O(samples x modes x points) for the march over the output grid, O(nodes x modes) for
 the load nodes (a chained step per node and mode, one damped-oscillator transition per load
@@ -17,6 +17,7 @@ and sample interval it has nodes in), O(pieces) mode-shape evaluations. Memory: 
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -24,6 +25,7 @@ from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.fe.model import check_points
 from tailbeam.progress import note, task
+from tailbeam.signals.sensor import measure
 from tailbeam.solvers.plate_loads.kernel import (
     add_particular,
     empty_outputs,
@@ -31,6 +33,7 @@ from tailbeam.solvers.plate_loads.kernel import (
     march,
     transition,
 )
+from tailbeam.solvers.plate_loads.loads import PlateLoads
 
 BATCH_NODES = 4096  # load nodes per batch (bounds the mode-shape table: batch x modes)
 DISC_BATCH = 256  # load discs evaluated per basis call (48 points each)
@@ -74,7 +77,7 @@ def plate_response(
     quasi_static : bool
         Add the truncated modes' quasi-static response -R F(t) at the points (R: the
         basis' residual cross compliance; velocity and acceleration as central differences
-        at the sample spacing, as ``CoupledResult.quasi_static_sample``). Ignored, with a
+        at the sample spacing, as ``ModalReplay.quasi_static_sample``). Ignored, with a
         note, if the basis has no static cross compliance.
     node_time_ulps : float
         A load's nodes inside one sample interval are chained with one transition matrix per
@@ -300,12 +303,10 @@ def _check_memory(n_points, n_samples, loads, n_modes, batch_nodes, max_bytes):
 
 def sensor_outputs(basis, zeta, loads, sensors, duration, *, load_radius=0.0, quasi_static=True):
     """name -> tailbeam.signals.sensor.SensorOutput for every sensor (SensorSpec) under ``loads``:
-    the chain of ``CoupledResult.sensor_outputs`` (true acceleration on the sensor's fine grid,
+    the chain of ``ModalReplay.sensor_outputs`` (true acceleration on the sensor's fine grid,
     mounted resonance, anti-alias FIR, sampling, noise) over [0, duration] s, driven by
     ``plate_response``. Sensors whose fine grids coincide share one plate response.
     ``sensor_signals(outputs)`` gives what ``write_sensors_csv`` takes."""
-    from tailbeam.signals.sensor import measure
-
     f_top = float(np.max(basis.frequencies_hz))
     positions = np.array([s.position for s in sensors], dtype=float).reshape(-1, 2)
     done = {}
@@ -324,6 +325,47 @@ def sensor_outputs(basis, zeta, loads, sensors, duration, *, load_radius=0.0, qu
         s.name: measure(s, lambda t, i=i: acceleration(t, i), duration, max_frequency_hz=f_top)
         for i, s in enumerate(sensors)
     }
+
+
+@dataclass(frozen=True, eq=False)
+class LoadResponse:
+    """The modal plate's response to the loads a run recorded: a ``Result``'s ``plate`` part
+    for the stream solvers.
+
+    Parameters
+    ----------
+    basis : tailbeam.plate.basis.ModalBasis
+        The kept modes.
+    zeta : ndarray
+        Damping ratio of each mode.
+    loads : PlateLoads
+        The plate's contact force histories and dead loads (N, pressing down).
+    quasi_static : bool
+        Add the truncated modes' quasi-static response at the sensors (residual flexibility).
+    """
+
+    basis: object
+    zeta: np.ndarray
+    loads: PlateLoads
+    quasi_static: bool = True
+
+    @classmethod
+    def from_records(cls, basis, zeta, contacts, dead, *, quasi_static=True) -> "LoadResponse":
+        """From a stream run's records: ``contacts`` (x m, y m, t_nodes s, forces N) piecewise
+        linear force histories and ``dead`` (x, y, t_from, t_to, force N) constant loads."""
+        loads = PlateLoads()
+        for x, y, t, f in contacts:
+            loads.add_contact(x, y, t, f)
+        for x, y, t0, t1, f in dead:
+            loads.add_dead_load(x, y, t0, t1, f)
+        return cls(basis, zeta, loads, quasi_static)
+
+    def sensor_outputs(self, sensors, duration: float) -> dict:
+        """name -> ``tailbeam.signals.sensor.SensorOutput`` of each ``SensorSpec`` of
+        ``sensors`` over [0, duration] s (``sensor_outputs``)."""
+        with task(f"sensor signals, {len(sensors)} sensors, {self.loads.n_nodes} load nodes"):
+            return sensor_outputs(self.basis, self.zeta, self.loads, sensors, duration,
+                                  quasi_static=self.quasi_static)  # fmt: skip
 
 
 def sensor_signals(outputs: dict) -> dict:

@@ -21,17 +21,20 @@ import numpy as np
 
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics.contacts import contact_table
-from tailbeam.results.records import PLATE, Event, EventKind, Impact
+from tailbeam.results.records import PLATE, End, Event, EventKind, Impact
+from tailbeam.results.result import Result
+from tailbeam.solvers.numerics.flight import lateral_leaves
 from tailbeam.solvers.rigid.model import Pair, make_pairs, time_to_contact
-from tailbeam.solvers.rigid.result import RigidResult
+from tailbeam.solvers.rigid.states import RigidStates
 from tailbeam.solvers.rigid.trajectory import TrajectoryBuilder
+from tailbeam.streams.generator import balls_as_particles
 
 
 @dataclass
 class ContactOutcome:
     """What a contact integrator reports, in the local time tau = t - t_contact (s)."""
 
-    status: str  # "separated", "rest" (rule B) or "duration" (the simulation ended)
+    status: End  # SEPARATED, REST (rule B) or DURATION (the simulation ended)
     tau_end: float
     v_out: float
     peak_force: float
@@ -49,24 +52,53 @@ class ContactOutcome:
 
 
 def simulate_balls(balls, plate, laws, duration, integrate_contact, *, gravity, rest_speed,
-                   max_contacts, max_steps) -> RigidResult:  # fmt: skip
+                   max_contacts, max_steps, labels=(), info=None) -> Result:  # fmt: skip
     """The rigid solvers' common part (``simulate_rigid`` and its reference): check the
-    inputs, make each ball's Pair (``make_pairs``) and ``run`` them with the solver's own
-    ``integrate_contact``; ``laws`` as ``make_pairs`` takes them."""
+    inputs, make each ball's Pair (``make_pairs``), ``run`` them with the solver's own
+    ``integrate_contact`` and return their Result.
+
+    Parameters
+    ----------
+    balls, plate, laws, duration
+        As ``simulate_rigid`` takes them (``laws`` as ``make_pairs`` takes them).
+    integrate_contact : callable
+        ``(pair, v_in, tau_max, max_steps) -> ContactOutcome``: one contact from
+        penetration 0.
+    labels : sequence of str
+        coal / gangue per ball (empty: from the material, ``default_label``).
+    info : dict, optional
+        The solver's description, for ``Result.info``.
+    """
     pairs = make_pairs(
         balls, plate, laws, duration, gravity=gravity, rest_speed=rest_speed,
         max_contacts=max_contacts, max_steps=max_steps,
     )  # fmt: skip
-    return run(
-        pairs, plate, balls, contact_table(balls, laws), duration, integrate_contact,
-        max_contacts=max_contacts, max_steps=max_steps,
+    contacts = contact_table(balls, laws)
+    states = run(pairs, plate, duration, integrate_contact, max_contacts, max_steps)
+    trajectories = {
+        st.pair.name: st.builder.build(
+            st.pair.radius, st.pair.mass, contacts.law(i, PLATE), st.pair.gravity
+        )
+        for i, st in enumerate(states)
+    }
+    return Result(
+        duration=float(duration),
+        particles=balls_as_particles(balls, labels),
+        impacts=sorted((imp for st in states for imp in st.impacts), key=lambda m: m.t_start),
+        events=sorted((ev for st in states for ev in st.events), key=lambda ev: ev.t),
+        leaves=lateral_leaves(balls, plate, duration),
+        message="reached the end of the simulation (duration)",
+        stats={"nfev": sum(st.nfev for st in states),
+               "n_steps": sum(st.n_steps for st in states)},
+        info=dict(info or {}),
+        states=RigidStates(trajectories, {st.pair.name: st.rest_time for st in states}),
     )  # fmt: skip
 
 
-def run(pairs, plate, balls, contacts, duration, integrate_contact, *, max_contacts, max_steps):
+def run(pairs, plate, duration, integrate_contact, max_contacts, max_steps) -> list:
     """Simulate all pairs on [0, duration]; ``integrate_contact(pair, v_in, tau_max,
-    max_steps)`` -> ContactOutcome integrates one contact starting at penetration 0;
-    ``contacts``: the balls' ``ContactTable`` (their ball-plate laws)."""
+    max_steps)`` -> ContactOutcome integrates one contact starting at penetration 0.
+    Returns each ball's state (its impacts, events, trajectory builder, work counts)."""
     states = []
     heap = []
     for i, p in enumerate(pairs):
@@ -80,29 +112,7 @@ def run(pairs, plate, balls, contacts, duration, integrate_contact, *, max_conta
         if not st.done:
             _predict(st, plate, duration, heap, i)
 
-    impacts = sorted((imp for st in states for imp in st.impacts), key=lambda m: m.t_start)
-    events = sorted((ev for st in states for ev in st.events), key=lambda ev: ev.t)
-    trajectories = {
-        st.pair.name: st.builder.build(
-            st.pair.radius, st.pair.mass, contacts.law(i, PLATE), st.pair.gravity
-        )
-        for i, st in enumerate(states)
-    }
-    return RigidResult(
-        balls=tuple(balls),
-        laws=contacts.plate_laws(),
-        duration=float(duration),
-        gravity=pairs[0].gravity,
-        impacts=impacts,
-        events=events,
-        rest_time={st.pair.name: st.rest_time for st in states},
-        trajectories=trajectories,
-        nfev=sum(st.nfev for st in states),
-        n_steps=sum(st.n_steps for st in states),
-        status=0,
-        message="reached the end of the simulation (duration)",
-        plate=plate,
-    )
+    return states
 
 
 class _BallState:
@@ -154,9 +164,10 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
     for tau, kind in out.events:
         st.events.append(Event(tc + tau, p.name, kind, PLATE))
     t_end = tc + out.tau_end
-    at_rest = out.status == "rest" or (out.status == "separated" and out.v_out < p.rest_speed)
-    v_out = {"separated": out.v_out, "rest": 0.0}.get(out.status, math.nan)
-    apex = v_out**2 / (2.0 * p.gravity) if p.gravity > 0.0 and out.status == "separated" else None
+    separated = out.status == End.SEPARATED
+    at_rest = out.status == End.REST or (separated and out.v_out < p.rest_speed)
+    v_out = {End.SEPARATED: out.v_out, End.REST: 0.0}.get(out.status, math.nan)
+    apex = v_out**2 / (2.0 * p.gravity) if p.gravity > 0.0 and separated else None
     st.impacts.append(
         Impact.single_ball(
             p,
@@ -177,7 +188,7 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
         st.builder.rest(t_end, p.radius - p.delta_static, p.mass * p.gravity)
         st.rest_time = t_end
         st.done = True
-    elif out.status == "duration":
+    elif out.status == End.DURATION:
         st.done = True
     else:
         st.t, st.z, st.vz = t_end, p.radius, out.v_out

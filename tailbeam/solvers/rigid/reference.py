@@ -17,7 +17,7 @@ from scipy.integrate import solve_ivp
 from tailbeam.errors import WorkLimitError
 from tailbeam.physics import impact
 from tailbeam.physics.bodies import STANDARD_GRAVITY
-from tailbeam.results.records import EventKind
+from tailbeam.results.records import End, EventKind
 from tailbeam.solvers.rigid import driver
 from tailbeam.solvers.rigid.model import (
     DEFAULT_MAX_CONTACTS,
@@ -52,12 +52,11 @@ def simulate_rigid_reference(
     def integrate(pair, v_in, tau_max, steps_left):
         return _Contact(pair, rtol).run(v_in, tau_max, steps_left)
 
-    result = driver.simulate_balls(
+    solver = f"reference: scipy solve_ivp DOP853 rtol={rtol:g}, restarted at kinks"
+    return driver.simulate_balls(
         balls, plate, laws, duration, integrate, gravity=gravity, rest_speed=rest_speed,
-        max_contacts=max_contacts, max_steps=max_steps,
+        max_contacts=max_contacts, max_steps=max_steps, info={"solver": solver},
     )  # fmt: skip
-    result.info["solver"] = f"reference: scipy solve_ivp DOP853 rtol={rtol:g}, restarted at kinks"
-    return result
 
 
 class _Contact:
@@ -96,7 +95,7 @@ class _Contact:
         maxima = (0.0, 0.0, 0.0)  # (peak force N, its tau s, max penetration m)
         work = [0, 0]  # nfev, steps
         fresh = None  # the switch event whose root we restart on
-        status, v_out = "duration", math.nan
+        status, v_out = End.DURATION, math.nan
         while tau < tau_max:
             evs = self._events(ramp, clamped, fresh, tau)
             rhs = self._rhs(ramp, clamped)
@@ -114,10 +113,10 @@ class _Contact:
             elif hit == EventKind.CONTACT_END:
                 y = self._exit_state(rhs, sol, tau, y, v_in, pieces, work)
                 events.append((tau, hit))
-                status, v_out = "separated", -y[1]
+                status, v_out = End.SEPARATED, -y[1]
                 break
             elif hit == EventKind.REST:
-                status, v_out = "rest", 0.0
+                status, v_out = End.REST, 0.0
                 break
         tau_start, tau_old, step, y_old, coef = (np.array(x) for x in zip(*pieces, strict=True))
         peak, tau_peak, pen = maxima

@@ -37,6 +37,8 @@ def simulate_rigid(
     rest_speed=DEFAULT_REST_SPEED,
     max_contacts=DEFAULT_MAX_CONTACTS,
     max_steps=DEFAULT_MAX_STEPS,
+    labels=(),
+    info=None,
 ):
     """Simulate ``balls`` (sequence of Ball) dropping on a rigid ``plate`` (Plate) on
     [0, ``duration``] s; ``laws``: the balls' ``ContactTable`` (``Scene.contacts()``,
@@ -45,16 +47,17 @@ def simulate_rigid(
     rtol: relative tolerance of the contact integration (errors in peak force, restitution
     and apex height come out near rtol); gravity in m/s^2; rest_speed in m/s (see
     tailbeam.solvers.rigid.model for the rest rules, 0 disables them); max_contacts: contacts per
-    ball; max_steps: integrator steps per ball. Returns a RigidResult.
+    ball; max_steps: integrator steps per ball; labels: coal / gangue per ball (empty: from
+    the material); info: more entries for ``Result.info``. Returns a ``tailbeam.Result`` whose
+    ``states`` are exact at any time.
     """
     rtol = check_rtol(rtol)
-    integrator = _KernelIntegrator(rtol)
-    result = driver.simulate_balls(
-        balls, plate, laws, duration, integrator, gravity=gravity, rest_speed=rest_speed,
-        max_contacts=max_contacts, max_steps=max_steps,
+    solver = f"tailbeam DOP853 (numba) rtol={rtol:g}, restarted at kinks"
+    return driver.simulate_balls(
+        balls, plate, laws, duration, _KernelIntegrator(rtol), gravity=gravity,
+        rest_speed=rest_speed, max_contacts=max_contacts, max_steps=max_steps, labels=labels,
+        info={"solver": solver, **(info or {})},
     )  # fmt: skip
-    result.info["solver"] = f"tailbeam DOP853 (numba) rtol={rtol:g}, restarted at kinks"
-    return result
 
 
 class _KernelIntegrator:

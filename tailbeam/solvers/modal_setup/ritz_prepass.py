@@ -220,10 +220,11 @@ def describe_tail(info: dict) -> str:
 
 def check_tail_scene(scene) -> None:
     """Before any work: InputError naming plate.tail_modes for "auto" on the stream solver
-    (its contacts take a number of oscillators), WorkLimitError naming plate.tail_modes if a
-    set k x the first-contact points exceeds MAX_RITZ_VECTORS (the coupled solver)."""
+    (its contacts take a number of oscillators) unless plate.tail is "quasi-static";
+    WorkLimitError naming plate.tail_modes if a set k x the first-contact points exceeds
+    MAX_RITZ_VECTORS (the coupled solver with plate.tail = "ritz")."""
     settings = scene.modal
-    if settings is None or settings.tail != "ritz":
+    if settings is None or settings.tail == "quasi-static":
         return
     if scene.needs_stream_solver:
         if settings.tail_modes == "auto":
@@ -235,7 +236,7 @@ def check_tail_scene(scene) -> None:
             )
         return
     tail_modes = settings.tail_modes_for(stream=False)
-    if tail_modes != "auto":
+    if settings.tail == "ritz" and tail_modes != "auto":
         _check_work(tail_modes, len(_unique(first_contacts(scene, "kirchhoff"))))
 
 

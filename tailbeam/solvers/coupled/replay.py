@@ -1,64 +1,44 @@
-"""What a coupled (flexible-plate) simulation returns.
-
-A ``tailbeam.results.result.Result`` with the same attributes as ``tailbeam.solvers.rigid.RigidResult``
-(impacts, events, rest_time, sample, time_grid, n_steps, status, message, impacts_table,
-particles_table) plus the plate: ``modal_sample`` / ``plate_sample`` give the
-exact modal state and the deflection, velocity and acceleration at any points and times (closed
-form between force nodes), and ``sensor_signals`` the accelerometer outputs.
+"""The solution of a single-ball run on the modal plate, replayed exactly at any time: the
+balls' states (``NodeStates``) and the plate's response (``ModalReplay``), the two parts of
+its ``tailbeam.Result``.
 
 The solution is stored as nodes: at each node time the ball heights, speeds and contact forces;
 the force is linear in time between nodes, so the balls are cubic and the modes exact there.
 """
 
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 
-from tailbeam.results.result import BallsResult
+from tailbeam.signals.sensor import measure
 from tailbeam.solvers.plate_loads.propagator import replay
 
 
-@dataclass(eq=False)
-class CoupledResult(BallsResult):
-    """Result of ``simulate_coupled``; see the module docstring. labels: coal / gangue per
-    ball (empty: ``tailbeam.scene.default_label``)."""
+@dataclass(frozen=True, eq=False)
+class NodeStates:
+    """The balls' states between force nodes, and when each came to rest.
 
-    plate_model = "modal"
+    Parameters
+    ----------
+    balls : tuple
+        The ``Ball``s, in the column order of the nodes.
+    gravity : float
+        m/s^2.
+    nodes : tuple
+        (t (k,) s, z (k, nb) m, vz (k, nb) m/s, F (k, nb) N, delta (k, nb) m).
+    rest_time : dict
+        Ball name -> time (s) it came to rest, nan if it did not.
+    """
 
     balls: tuple
-    laws: tuple
-    basis: object
-    duration: float
     gravity: float
-    zeta: np.ndarray
-    impacts: list
-    events: list
-    rest_time: dict
-    nodes: tuple = field(repr=False)  # (t, z, vz, F, delta)
-    seg_phase: np.ndarray = field(repr=False)
-    phis: np.ndarray = field(repr=False)
-    sensors: tuple = ()
-    contact_points: tuple = ()  # (t_start s, ball index, x m, y m, load radius m) per contact
-    n_steps: int = 0
-    status: int = 0
-    message: str = ""
-    info: dict = field(default_factory=dict)
-    _cross: dict = field(default_factory=dict, repr=False)  # residual cross compliances
-    labels: tuple = ()
-
-    @property
-    def nfev(self) -> int:
-        """Contact-law evaluations are part of each step's Newton solve; counted as steps."""
-        return self.n_steps
-
-    def _plate(self):
-        return self.basis.plate
+    nodes: tuple = field(repr=False)
+    rest_time: dict = field(default_factory=dict)
 
     def sample(self, times) -> dict:
-        """Ball states at ``times`` (s, within [0, duration]): name -> {"z" (m), "vz" (m/s),
-        "force" (N)} arrays; exact (cubic between force nodes, closed form in flight)."""
-        t = self._times(times, slack=1e-12)
+        """Ball states at ``times`` (s): name -> {"z" (m), "vz" (m/s), "force" (N)} arrays;
+        exact (cubic between force nodes, closed form in flight)."""
+        t = np.asarray(times, dtype=float)
         tn, zn, vn, fn, _dn = self.nodes
         k = np.clip(np.searchsorted(tn, t, side="right") - 1, 0, len(tn) - 1)
         k1 = np.minimum(k + 1, len(tn) - 1)
@@ -76,6 +56,42 @@ class CoupledResult(BallsResult):
             vz = vn[k, b] - self.gravity * s + (f0 * s + slope * s**2 / 2) / m
             out[ball.name] = {"z": z, "vz": vz, "force": f0 + slope * s}
         return out
+
+
+@dataclass(eq=False)
+class ModalReplay:
+    """The modal plate under the balls' contact forces, exact at any time.
+
+    ``modal_sample`` and ``sample`` give the exact modal state and the deflection, velocity
+    and acceleration at any points and times (closed form between force nodes); with
+    residual flexibility the truncated modes' quasi-static response is added at points.
+
+    Parameters
+    ----------
+    basis : tailbeam.plate.basis.ModalBasis
+        The kept modes.
+    zeta : ndarray
+        Damping ratio of each mode.
+    nodes : tuple
+        The force nodes, as ``NodeStates.nodes``.
+    seg_phase : ndarray
+        Per node, the row of ``phis`` (the balls' mode shapes) valid from it.
+    phis : ndarray
+        (phases, nb, n) the mode shapes under each ball's load, per phase.
+    contact_points : tuple
+        (t_start s, ball index, x m, y m, load radius m) per contact.
+    residual_flexibility : bool
+        Add the truncated modes' quasi-static response at points.
+    """
+
+    basis: object
+    zeta: np.ndarray
+    nodes: tuple = field(repr=False)
+    seg_phase: np.ndarray = field(repr=False)
+    phis: np.ndarray = field(repr=False)
+    contact_points: tuple = ()
+    residual_flexibility: bool = False
+    _cross: dict = field(default_factory=dict, repr=False)  # residual cross compliances
 
     def modal_sample(self, times):
         """(q, q', q'') of every mode at ``times`` (s), each (n_modes, len(times)); exact."""
@@ -101,7 +117,7 @@ class CoupledResult(BallsResult):
         inv[order] = np.arange(len(order))
         return q[:, inv], qd[:, inv], qdd[:, inv]
 
-    def plate_sample(self, times, points, *, quasi_static: bool = True) -> dict:
+    def sample(self, times, points, *, quasi_static: bool = True) -> dict:
         """Plate deflection "w" (m, + up), velocity "v" (m/s), acceleration "a" (m/s^2) at
         points (p, 2) m and times (s): each array (p, len(times)). The kept modes exactly,
         plus (quasi_static, with residual flexibility on) the truncated modes' quasi-static
@@ -119,7 +135,7 @@ class CoupledResult(BallsResult):
         """True if the truncated modes' quasi-static response is added at points (residual
         flexibility on and a basis that knows its static cross compliance)."""
         return bool(
-            self.info.get("residual_flexibility")
+            self.residual_flexibility
             and self.contact_points
             and getattr(self.basis, "static_deflection_at", None) is not None
         )
@@ -137,7 +153,7 @@ class CoupledResult(BallsResult):
         out = {k: np.zeros((len(points), len(t))) for k in ("w", "v", "a")}
         h = _difference_step(t, float(np.max(self.basis.frequencies_hz)))
         tn, _z, _v, fn, _d = self.nodes
-        for b in range(len(self.balls)):
+        for b in range(fn.shape[1]):
             mine = [c for c in self.contact_points if c[1] == b]
             if not mine:
                 continue
@@ -161,25 +177,25 @@ class CoupledResult(BallsResult):
             self._cross[key] = self.basis.residual_cross_compliance((x, y), points, r)
         return self._cross[key]
 
-    def plate_energy(self, times) -> np.ndarray:
+    def energy(self, times) -> np.ndarray:
         """Vibration energy of the plate's kept modes, J, at ``times``."""
         q, qd, _ = self.modal_sample(times)
         om = np.asarray(self.basis.omega)[:, None]
         return 0.5 * np.sum(qd**2 + om**2 * q**2, axis=0)
 
-    def true_acceleration(self, point, times) -> np.ndarray:
-        """Plate acceleration normal to the plate (m/s^2) at one point (x, y), before any sensor."""
-        return self.plate_sample(times, [point])["a"][0]
+    def acceleration(self, point, times) -> np.ndarray:
+        """Plate acceleration normal to the plate (m/s^2) at one point (x, y), before any
+        sensor."""
+        return self.sample(times, [point])["a"][0]
 
-    @cached_property
-    def sensor_outputs(self) -> dict:
-        """name -> tailbeam.signals.sensor.SensorOutput for every sensor (computed on first use)."""
-        from tailbeam.signals.sensor import measure
-
+    def sensor_outputs(self, sensors, duration: float) -> dict:
+        """name -> ``tailbeam.signals.sensor.SensorOutput`` of each ``SensorSpec`` of
+        ``sensors`` over [0, duration] s."""
+        top = float(np.max(self.basis.frequencies_hz))
         return {
-            s.name: measure(s, lambda t, p=s.position: self.true_acceleration(p, t), self.duration,
-                            max_frequency_hz=float(np.max(self.basis.frequencies_hz)))
-            for s in self.sensors
+            s.name: measure(s, lambda t, p=s.position: self.acceleration(p, t), duration,
+                            max_frequency_hz=top)
+            for s in sensors
         }  # fmt: skip
 
 
