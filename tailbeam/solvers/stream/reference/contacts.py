@@ -2,8 +2,6 @@
 contact), the leaves and the event log; a pair's contact opens and closes here.
 """
 
-import math
-
 from tailbeam.results.records import PLATE, Event, EventKind, Impact, LeaveEvent
 
 
@@ -35,32 +33,31 @@ class ContactLog:
         return PLATE if pair.j < 0 else self.balls[pair.j].name
 
     def open(self, pair, t, kin, x_i, v, li, lj) -> None:
-        """Start the contact of ``pair`` at time t (s): its region flags, peaks and records.
+        """Start the contact of ``pair`` at time t (s) with its records (one per ball).
 
         kin: the pair's ``PairKinematics`` at t; x_i: ball i's centre (m); v: velocities
         (n, 3) of the present balls (m/s); li, lj: state positions of balls i and j.
         """
-        pair.in_contact, pair.ramp, pair.clamped = True, True, False
-        pair.peak, pair.t_peak = 0.0, math.nan
-        pair.pen = max(0.0, float(kin.penetration[0]))
-        if pair.j < 0 and self.plate is not None and self.plate.frozen:
-            pair.phi0 = self.plate.shapes_at(x_i[:2])[0]
         n = kin.normal[0]
         point = x_i - n * (self.balls[pair.i].radius - 0.5 * max(kin.penetration[0], 0.0))
         v_in = float(-v[li] @ n)
         # approach speed of a plate row: the ball's (as v_in), also on the modal plate
         rate = float(kin.rate[0]) if pair.j >= 0 or self.plate is None else v_in
-        pair.records = [
+        records = [
             Impact(ball=self.balls[pair.i].name, partner=self.partner_name(pair), t_start=t,
                    x=point[0], y=point[1], v_in=v_in, approach_in=rate)
         ]  # fmt: skip
         if pair.j >= 0:
-            pair.records.append(
+            records.append(
                 Impact(ball=self.balls[pair.j].name, partner=self.balls[pair.i].name,
                        t_start=t, x=point[0], y=point[1], v_in=float(v[lj] @ n),
                        approach_in=rate)
             )  # fmt: skip
-        self.contacts.extend(pair.records)
+        phi0 = None
+        if pair.j < 0 and self.plate is not None and self.plate.frozen:
+            phi0 = self.plate.shapes_at(x_i[:2])[0]
+        pair.start(records, float(kin.penetration[0]), phi0)
+        self.contacts.extend(records)
         self.log(t, EventKind.CONTACT_START, pair)
 
     def close(self, pair, t, kin, v, li, lj, end) -> None:
@@ -72,8 +69,7 @@ class ContactLog:
         out = -float(kin.rate[0]) if pair.j >= 0 or self.plate is None else outs[0]
         for rec, v_out in zip(pair.records, outs, strict=True):
             rec.t_end, rec.v_out, rec.approach_out, rec.end = t, v_out, out, end
-        pair.write_peaks()
-        pair.in_contact, pair.records, pair.phi0 = False, [], None
+        pair.stop()
         self.log(t, EventKind.CONTACT_END, pair)
 
     def left(self, ball, edge, t) -> None:

@@ -52,6 +52,19 @@ class Pair:
         """Whether the law has a STEP kink at delta = d (it does only with damping)."""
         return self.law.damping > 0.0
 
+    def start(self, records, penetration, phi0=None) -> None:
+        """Open a contact with its ``records`` (``Impact``, one per ball) at ``penetration``
+        (m; 0 if negative), in the ramp region, unclamped; ``phi0``: the mode shapes a
+        frozen plate contact keeps."""
+        self.in_contact, self.ramp, self.clamped = True, True, False
+        self.peak, self.t_peak, self.pen = 0.0, math.nan, max(0.0, penetration)
+        self.records, self.phi0 = records, phi0
+
+    def stop(self) -> None:
+        """Close the contact: its peaks go into its records, which it then lets go."""
+        self.write_peaks()
+        self.in_contact, self.records, self.phi0 = False, [], None
+
     def write_peaks(self) -> None:
         """Copy the peak force, its time and the largest penetration into the records."""
         for rec in self.records:
