@@ -219,9 +219,9 @@ def test_gap_rows_are_polynomial_to_round_off_with_exact_shapes(basis, monkeypat
 
     from tailbeam.results.records import EventKind
     from tailbeam.solvers.numerics.step_events import STEP_POINTS, chebyshev_coefficients
-    from tailbeam.solvers.stream.reference import solver as sr
+    from tailbeam.solvers.stream.reference.events import EventSearch
 
-    worst, detect = [], sr._Reference.detect
+    worst, detect = [], EventSearch.detect
     u = np.linspace(-1.0, 1.0, 101)
     gaps = (EventKind.CONTACT_START, EventKind.CONTACT_END)
 
@@ -235,7 +235,7 @@ def test_gap_rows_are_polynomial_to_round_off_with_exact_shapes(basis, monkeypat
             worst.append(float(np.max(np.abs(true - interp) / r2)))
         return detect(self, dense, t0, t1, fresh)
 
-    monkeypatch.setattr(sr._Reference, "detect", checked)
+    monkeypatch.setattr(EventSearch, "detect", checked)
     balls = _four_balls() + [Ball("e", SANDSTONE, 0.02, (-0.25, 0.0, 0.03), (5.0, 0.0, -0.3))]
     res = simulate_stream_reference(balls, InclinedPlate(), 0.025,
                                     plate=ReferencePlate(basis, 0.0))  # fmt: skip

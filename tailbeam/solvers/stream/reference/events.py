@@ -1,18 +1,18 @@
 """The stream reference's events: the watched functions (rows) and the search for the first
-crossing on a step (a mixin of ``tailbeam.solvers.stream.reference.solver._Reference``, which
-provides ``pairs``, ``active``, ``incline`` and the state layout of ``reference_state``).
+crossing on a step.
 
-Event search (``tailbeam.solvers.numerics.step_events``). DOP853's dense output is a polynomial of
-degree 7 in time on each step, so the squared distance of two centres (and the plate gap,
-the edge distances) is a polynomial of degree <= 14 there, interpolated exactly at 15
-Chebyshev points and certified or root-found: no contact is missed, however short the
+Event search (``tailbeam.solvers.numerics.step_events``). DOP853's dense output is a
+polynomial of degree 7 in time on each step, so the squared distance of two centres (and the
+plate gap, the edge distances) is a polynomial of degree <= 14 there, interpolated exactly at
+15 Chebyshev points and certified or root-found: no contact is missed, however short the
 step's approach and retreat. The clamp indicator (not polynomial) is sampled at the 15 points
 and bracketed with ``brentq``. A redone step is checked again (a root placed by a step that
 straddled the kink can be late). Each event fires when its function passes a dead band
-beyond zero (see ``ReferenceEvents.rows``), against round-off chatter at grazing contacts.
+beyond zero (see ``EventSearch.rows``), against round-off chatter at grazing contacts.
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import brentq
@@ -27,12 +27,55 @@ from tailbeam.solvers.numerics.step_events import (
     first_downward_crossing,
 )
 
+CONTACT = frozenset({EventKind.CONTACT_START, EventKind.CONTACT_END})  # one row, two sides
+CLAMP = frozenset({EventKind.CLAMP_ON, EventKind.CLAMP_OFF})
 
-class ReferenceEvents:
-    """Rows, their values and the first event on a step of the stream reference."""
 
-    def rows(self):
-        """Watched functions: (key, expected sign, polynomial?, dead band) in a fixed order.
+class RowKey(NamedTuple):
+    """What a row watches: ``kind`` (an ``EventKind``) of ``target``, a pair key (i, j) or,
+    for ``LEAVE``, (ball, edge index into ``EDGES``)."""
+
+    kind: EventKind
+    target: tuple
+
+
+class Row(NamedTuple):
+    """A watched function: its ``key``, the ``sign`` (+1 or -1) of its value on the side it
+    is on, whether it is a ``polynomial`` on a step, and its dead ``band``."""
+
+    key: RowKey
+    sign: float
+    polynomial: bool
+    band: float
+
+
+class EventSearch:
+    """The rows of the present balls and pairs, their values and the first event on a step.
+
+    Parameters
+    ----------
+    pairs : PairSet
+        The watched pairs.
+    layout : StateLayout
+        Which balls are present; its ``states_at`` reads a step's dense output.
+    kinematics : Kinematics
+        The pairs' contact kinematics.
+    incline : InclinedPlate
+        The plate's edges.
+    plate : ReferencePlate or None
+        The modal plate (its top wavenumber bounds a step's sideways travel), or None.
+    """
+
+    def __init__(self, pairs, layout, kinematics, incline, plate):
+        self.pairs = pairs
+        self.layout = layout
+        self.kinematics = kinematics
+        self.incline = incline
+        self.plate = plate
+        self.states_at = layout.states_at
+
+    def rows(self) -> list:
+        """Watched functions (``Row``) in a fixed order.
 
         A row's event is its value crossing the dead band on the far side of zero (squared
         distances: 1e-12 (r_i + r_j)^2, i.e. a penetration of ~5e-13 (r_i + r_j), ~1e-14 m;
@@ -43,40 +86,42 @@ class ReferenceEvents:
         for pk, p in self.pairs.items():
             band = 1e-12 * p.radius_sum**2
             if not p.in_contact:
-                rows.append(((EventKind.CONTACT_START, pk), 1.0, True, band))
+                rows.append(Row(RowKey(EventKind.CONTACT_START, pk), 1.0, True, band))
                 continue
-            rows.append(((EventKind.CONTACT_END, pk), -1.0, True, band))
+            rows.append(Row(RowKey(EventKind.CONTACT_END, pk), -1.0, True, band))
             if p.kinked:
-                rows.append(((EventKind.FULL_DAMPING, pk), 1.0 if p.ramp else -1.0, True, band))
+                sign = 1.0 if p.ramp else -1.0
+                rows.append(Row(RowKey(EventKind.FULL_DAMPING, pk), sign, True, band))
             if p.kinked and p.law.clamp:
                 sign = -1.0 if p.clamped else 1.0
-                rows.append(((EventKind.CLAMP_ON, pk), sign, False, 1e-10))
-        for b in self.active:
+                rows.append(Row(RowKey(EventKind.CLAMP_ON, pk), sign, False, 1e-10))
+        for b in self.layout.active:
             for e in range(len(EDGES)):
-                rows.append(((EventKind.LEAVE, (b, e)), 1.0, True, 1e-13))
+                rows.append(Row(RowKey(EventKind.LEAVE, (b, e)), 1.0, True, 1e-13))
         return rows
 
-    def row_values(self, rows, x, v, modes=None):
-        """Values of ``rows`` at the states x, v (K, n, 3) (and modes, each (K, m)): array
-        (len(rows), K)."""
-        pair_keys = [r[0][1] for r in rows if r[0][0] != EventKind.LEAVE]
+    def row_values(self, rows, x, v, modes=None) -> np.ndarray:
+        """Values of ``rows`` at the states x (m), v (m/s), (K, n, 3) each (and modes, each
+        (K, m)): array (len(rows), K) (m^2 for distances, m for edges)."""
+        pair_keys = [r.key.target for r in rows if r.key.kind != EventKind.LEAVE]
         pairs = [self.pairs[k] for k in dict.fromkeys(pair_keys)]
         index = {id(p): q for q, p in enumerate(pairs)}
         out = np.empty((len(rows), x.shape[0]))
         if pairs:
-            kin, _, _, _ = self.kinematics(pairs, x, v, modes)
+            kin, _, _, _ = self.kinematics.of(pairs, x, v, modes)
             delta = kin.penetration.reshape(x.shape[0], len(pairs)).T
             rate = kin.rate.reshape(x.shape[0], len(pairs)).T
-        loc = self.local()
+        loc = self.layout.local()
         edges = self.incline.edge_distances(x[..., :2])  # (K, n, 4)
-        for r, ((kind, key), *_) in enumerate(rows):
+        for r, row in enumerate(rows):
+            kind, key = row.key
             if kind == EventKind.LEAVE:
                 out[r] = edges[:, loc[key[0]], key[1]]
                 continue
             p = self.pairs[key]
             q = index[id(p)]
             dist = p.radius_sum - delta[q]
-            if kind in (EventKind.CONTACT_START, EventKind.CONTACT_END):
+            if kind in CONTACT:
                 out[r] = dist**2 - p.radius_sum**2
             elif kind == EventKind.FULL_DAMPING:
                 out[r] = dist**2 - (p.radius_sum - p.law.penetration) ** 2
@@ -87,31 +132,24 @@ class ReferenceEvents:
                 ]
         return out
 
-    def states_at(self, dense, times):
-        """Positions, velocities (K, n, 3) and modes ((K, m) each, or None) at ``times``."""
-        ys = np.atleast_2d(dense(times).T)  # (K, 6n [+ 2m])
-        n = len(self.active)
-        x, v = ys[:, : 3 * n].reshape(-1, n, 3), ys[:, 3 * n : 6 * n].reshape(-1, n, 3)
-        return x, v, self.modes(ys)
-
     def detect(self, dense, t0, t1, fresh):
-        """Earliest (row, time) of an event on [t0, t1], or None."""
+        """Earliest event on the step [t0, t1] (s) with dense output ``dense``: (row, time)
+        or None. ``fresh``: keys of the events applied at t0."""
         rows = self.rows()
         if not rows or t1 <= t0:
             return None
         values = self.row_values(rows, *self.states_at(dense, t0 + STEP_POINTS * (t1 - t0)))
         # g = sign x value + band: positive on the row's side, its event where g < 0
         g = (
-            np.array([r[1] for r in rows])[:, None] * values
-            + np.array([r[3] for r in rows])[:, None]
+            np.array([r.sign for r in rows])[:, None] * values
+            + np.array([r.band for r in rows])[:, None]
         )
         coef = chebyshev_coefficients(g)  # Chebyshev coefficients of every row
-        certified = certified_positive(coef) & np.array([r[2] for r in rows])
+        certified = certified_positive(coef) & np.array([r.polynomial for r in rows])
         best = (math.inf, None)
         for r in np.flatnonzero(~certified):
-            key, _, poly, _ = rows[r]
-            is_fresh = _same_switch(key, fresh)
-            if poly:
+            is_fresh = _same_switch(rows[r].key, fresh)
+            if rows[r].polynomial:
                 s = first_downward_crossing(coef[r], g[r], is_fresh)
             else:
                 s = self.first_sampled_crossing(rows[r], g[r], dense, t0, t1, is_fresh)
@@ -122,11 +160,11 @@ class ReferenceEvents:
         return best[1], t0 + best[0] * (t1 - t0)
 
     def first_sampled_crossing(self, row, values, dense, t0, t1, is_fresh):
-        """First s where a sampled (non-polynomial) row leaves its side: a node on the wrong
-        side right after one on the right side, bracketed by brentq. A row an event just sat
-        on (``is_fresh``) may start on the wrong side by round-off (its root was located on
-        the discarded step's interpolant): only a right-to-wrong change counts for it."""
-        key, sign, _, band = row
+        """First s in [0, 1] where a sampled (non-polynomial) row leaves its side: a node on
+        the wrong side right after one on the right side, bracketed by brentq. A row an event
+        just sat on (``is_fresh``) may start on the wrong side by round-off (its root was
+        located on the discarded step's interpolant): only a right-to-wrong change counts
+        for it."""
         right = values > 0.0
         if not is_fresh and not right[0]:
             return 0.0
@@ -137,23 +175,38 @@ class ReferenceEvents:
 
         def f(s):
             states = self.states_at(dense, np.array([t0 + s * (t1 - t0)]))
-            return sign * self.row_values([row], *states)[0, 0] + band
+            return row.sign * self.row_values([row], *states)[0, 0] + row.band
 
         return brentq(f, STEP_POINTS[k - 1], STEP_POINTS[k], xtol=1e-15, rtol=1e-15)
 
+    def within_band(self, row, y) -> bool:
+        """Whether ``row`` at state vector y has passed zero by no more than its dead band,
+        i.e. its event may be applied there."""
+        x, v = self.layout.split(y)
+        modes = self.layout.modes(y[None])
+        return bool(row.sign * self.row_values([row], x[None], v[None], modes)[0, 0] <= row.band)
+
+    def too_far(self, dense, t0, t1) -> bool:
+        """Modal plate: whether a ball moved more than 1 / k_max sideways on the step [t0, t1]
+        (k_max: the top mode's wavenumber, 1/m). Below it the mode shapes along the path are so
+        smooth that the 15-point interpolant of the plate gap rows is exact to round-off
+        (``tailbeam.solvers.stream.reference.solver``); the step is then redone shorter."""
+        if self.plate is None or t1 <= t0 or not self.layout.active:
+            return False
+        x = self.states_at(dense, t0 + STEP_POINTS * (t1 - t0))[0]
+        travel = np.max(np.linalg.norm(x[:, :, :2] - x[:1, :, :2], axis=-1))
+        return bool(self.plate.k_max * travel > 1.0)
+
 
 def _same_switch(key, fresh) -> bool:
-    """Whether the row ``key`` is the function an event at the restart time sat on."""
+    """Whether the row ``key`` is the function an event at the restart time sat on (the same
+    kind, or the other side of the same contact or clamp row, of the same target)."""
     kind, k = key
     for f_kind, f_k in fresh:
         if f_k != k:
             continue
-        same = {EventKind.CONTACT_START, EventKind.CONTACT_END}
-        clamp = {EventKind.CLAMP_ON, EventKind.CLAMP_OFF}
-        if (
-            f_kind == kind
-            or (kind in same and f_kind in same)
-            or (kind in clamp and f_kind in clamp)
-        ):
+        if f_kind == kind or (kind in CONTACT and f_kind in CONTACT):
+            return True
+        if kind in CLAMP and f_kind in CLAMP:
             return True
     return False

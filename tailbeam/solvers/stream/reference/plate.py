@@ -43,9 +43,32 @@ GRID = 41  # points per side where max |phi| is sampled (scale of the modal tole
 
 
 class ReferencePlate:
-    """The modal plate ``basis`` (a ``ModalBasis``) with damping ratios ``zeta`` (one per
-    mode, in [0, 1)) for ``simulate_stream_reference(..., plate=...)``; ``shapes`` is
-    ``"exact"`` or ``"frozen"`` (module docstring). The plate starts at rest (q = q' = 0)."""
+    """The two-way modal plate of ``simulate_stream_reference(..., plate=...)``; it starts at
+    rest (q = q' = 0).
+
+    Parameters
+    ----------
+    basis : ModalBasis
+        Mass-normalised modes of the plate: angular frequencies ``omega`` (rad/s) and shapes
+        (1/sqrt(kg)).
+    zeta : float or array_like
+        Modal damping ratios in [0, 1), one per mode or one for all.
+    shapes : str
+        ``"exact"`` (shapes evaluated at the ball's current position) or ``"frozen"`` (a
+        plate contact keeps the shapes of its first touch); see the module docstring.
+
+    Attributes
+    ----------
+    omega : ndarray
+        Angular frequencies (rad/s), one per mode.
+    n_modes : int
+        Number of modes.
+    phi_scale : float
+        Largest |phi| over the plate (1/sqrt(kg)), sampled on a grid: the scale of the modal
+        tolerances.
+    k_max : float
+        Wavenumber of the top mode (1/m), from the Kirchhoff dispersion relation.
+    """
 
     def __init__(self, basis, zeta, shapes: str = "exact"):
         self.basis = basis
@@ -68,6 +91,7 @@ class ReferencePlate:
 
     @property
     def frozen(self) -> bool:
+        """Whether a plate contact keeps the shapes of its first touch."""
         return self.shapes == "frozen"
 
     def check_size(self, incline) -> None:

@@ -8,9 +8,8 @@ step through its ``OdeSolver`` class so that every step can be checked for conta
 
 * ball-ball and ball-plate contacts use the IMPACT law of ``tailbeam.physics.contact_law``
   (from the contact table, ``tailbeam.physics.contacts``: ball-ball R = R1 R2 / (R1 + R2),
-  E* of both materials; ball-plate), the
-  pair geometry of ``tailbeam.physics.pair`` and the plate frame of
-  ``tailbeam.physics.incline`` (gravity g (sin theta, 0, -cos theta));
+  E* of both materials; ball-plate), the pair geometry of ``tailbeam.physics.pair`` and the
+  plate frame of ``tailbeam.physics.incline`` (gravity g (sin theta, 0, -cos theta));
 * events at every kink: contact start and end of every pair, penetration = d (STEP kink,
   when c > 0), clamp on/off (when c > 0 and the clamp is on), and a ball's centre passing an
   edge of the plate (the ball leaves and is dropped). Inside a region each pair's force is
@@ -18,22 +17,29 @@ step through its ``OdeSolver`` class so that every step can be checked for conta
   to end exactly at the event, where the integration restarts with the new region, so no
   accepted step straddles a kink.
 
-Modules: the state vector, kinematics and right-hand side (``reference_state``), the event
-rows and their search (``reference_events``), the pairs, contacts, leaves and releases
-(``reference_contacts``), what an accepted step records (``reference_steps``); this module
-holds the driver loop and the result.
+The parts, each given the others it uses when it is made (``_simulate`` wires them):
 
-Modal plate (``tailbeam.solvers.stream.reference.plate``: the model, exact or frozen mode shapes).
-The state gains the modal coordinates [q | q'] after the balls (atol: deflections to rtol x
-1 mm, rates to rtol x 1 m/s). A ball's plate rows use the gap z - w, w = phi(x, y) . q.
-What is certified: with frozen shapes (a contact's) the rows are polynomials of degree <= 14
-on a step, as on the rigid plate (``reference_events``). With exact shapes phi(x(s), y(s))
-is not a polynomial; the 15 values are exact samples, and the certificate and the root
-search act on their interpolant. Every step is bounded so that no ball moves sideways more
-than 1 / k_max (k_max: the top mode's wavenumber; the step is redone shorter otherwise):
-along such a path each shape's Chebyshev coefficients fall like (k L / 4)^n / n!, and the
-interpolant misses the row only by products of them with the top coefficients of the dense
-output (~rtol): an estimate (~1e-12 of the row's scale; measured 1.5e-14 of r^2), not a
+* ``state.StateLayout``: which balls the state vector holds, in which order, and the modes;
+* ``pairs.PairSet``: the watched pairs, their laws and region flags;
+* ``kinematics.Kinematics``: the pairs' penetration, rate and normal at given states;
+* ``dynamics.Dynamics``: the right-hand side of the current contacts;
+* ``events.EventSearch``: the watched functions (rows) and the first event on a step;
+* ``changes.SceneChanges``: an event or a release applied to the pairs and the state;
+* ``contacts.ContactLog``: the records written out (contacts, leaves, the event log);
+* ``steps.StepSeries``: what an accepted step records (peaks, energy, states);
+* ``loop.StepLoop``: drives DOP853 (``loop.Integrator``) from event to event.
+
+Modal plate (``tailbeam.solvers.stream.reference.plate``: the model, exact or frozen mode
+shapes). The state gains the modal coordinates [q | q'] after the balls (atol: deflections to
+rtol x 1 mm, rates to rtol x 1 m/s). A ball's plate rows use the gap z - w,
+w = phi(x, y) . q. What is certified: with frozen shapes (a contact's) the rows are
+polynomials of degree <= 14 on a step, as on the rigid plate (``events``). With exact shapes
+phi(x(s), y(s)) is not a polynomial; the 15 values are exact samples, and the certificate
+and the root search act on their interpolant. Every step is bounded so that no ball moves
+sideways more than 1 / k_max (k_max: the top mode's wavenumber; the step is redone shorter
+otherwise): along such a path each shape's Chebyshev coefficients fall like
+(k L / 4)^n / n!, and the interpolant misses the row only by products of them with the top
+coefficients of the dense output (~rtol): an estimate (~1e-12 of the row's scale), not a
 certificate. A crossing found on the interpolant is applied only where the true row lies
 within its dead band (else the step goes on and finds it again, closer), so no event is
 applied early; a dip narrower than that estimate could be missed. The modes also bound the
@@ -45,28 +51,57 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import DOP853
 
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.contact_law import HERTZ_EXPONENT
 from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
-from tailbeam.solvers.numerics.step_events import STEP_POINTS
-from tailbeam.solvers.stream.reference.contacts import ReferenceContacts
-from tailbeam.solvers.stream.reference.events import ReferenceEvents
+from tailbeam.solvers.stream.reference.changes import SceneChanges
+from tailbeam.solvers.stream.reference.contacts import ContactLog
+from tailbeam.solvers.stream.reference.dynamics import Dynamics
+from tailbeam.solvers.stream.reference.events import EventSearch
+from tailbeam.solvers.stream.reference.kinematics import Kinematics
+from tailbeam.solvers.stream.reference.loop import Integrator, StepLoop
+from tailbeam.solvers.stream.reference.pairs import PairSet
 from tailbeam.solvers.stream.reference.plate import ReferencePlate
-from tailbeam.solvers.stream.reference.state import ReferenceState
-from tailbeam.solvers.stream.reference.steps import ReferenceSteps
+from tailbeam.solvers.stream.reference.state import StateLayout
+from tailbeam.solvers.stream.reference.steps import StepSeries
 
-SAME_TIME = 1e-9  # events closer than this (fraction of a step) are simultaneous
 MODAL_STEPS_PER_PERIOD = 5  # a lower bound of the steps per period of the top mode
 
 
 @dataclass
 class StreamReferenceResult:
-    """Contacts (one ``Impact`` per ball per contact), leave events, the event log
-    (``Event`` records in time order), and per accepted step: times, total energy (J) and states
-    (names of the balls present, positions (n, 3) m, velocities (n, 3) m/s)."""
+    """What a run of the stream reference reports.
+
+    Parameters
+    ----------
+    names : tuple of str
+        The balls' names, in the order given.
+    masses : ndarray
+        The balls' masses (kg).
+    contacts : list of Impact
+        One record per ball per contact, in order of first touch.
+    leaves : list of LeaveEvent
+        The balls that left over an edge, in time order.
+    events : list of Event
+        The event log, in time order.
+    times : ndarray
+        Time (s) of the start and of every accepted step.
+    energy : ndarray
+        Total energy (J) of the balls present (kinetic, gravitational, elastic; on the
+        modal plate also the modes') at ``times``.
+    states : list of tuple
+        Per entry of ``times``: names of the balls present, positions (n, 3) (m) and
+        velocities (n, 3) (m/s).
+    steps : int
+        DOP853 steps taken, redone ones included.
+    info : dict
+        The solver, the plate and the duration (s).
+    plate_states : list of tuple
+        Modal plate: (q, q') per entry of ``times`` (m sqrt(kg), m sqrt(kg) / s); empty on
+        the rigid plate.
+    """
 
     names: tuple
     masses: np.ndarray
@@ -78,9 +113,10 @@ class StreamReferenceResult:
     states: list
     steps: int
     info: dict
-    plate_states: list = field(default_factory=list)  # (q, q') per step (modal plate)
+    plate_states: list = field(default_factory=list)
 
     def contacts_of(self, ball: str) -> list:
+        """The contact records of the ball named ``ball``."""
         return [c for c in self.contacts if c.ball == ball]
 
 
@@ -100,18 +136,40 @@ def simulate_stream_reference(
     plate: ReferencePlate | None = None,
     contacts=None,
 ) -> StreamReferenceResult:
-    """Integrate ``balls`` (``tailbeam.Ball``, positions and velocities in the plate frame)
-    on ``incline`` for ``duration`` s; see the module docstring.
+    """Integrate a stream of balls on an inclined plate, every pair watched (module
+    docstring).
 
-    damping c (N s/m), penetration d (m), clamp, exponent e: the IMPACT parameters of every
-    pair (stiffness from Hertz). rtol: DOP853's relative tolerance (atol = rtol x 1 mm on
-    positions, rtol x 1 m/s on velocities). max_steps bounds the work (WorkLimitError).
-    release_times (s, one per ball, default all 0): a ball enters the scene at its time, at
-    its given position and velocity (event ``release``; the energy series jumps there).
-    progress: optional callable, called with the time (s) reached after every accepted step.
-    plate: a ``ReferencePlate`` (the modal plate, two-way,
-    ``tailbeam.solvers.stream.reference.plate``) or None (the rigid plate). contacts: the
-    balls' ``ContactTable`` (its settings then replace the IMPACT parameters given here).
+    Parameters
+    ----------
+    balls : sequence of Ball
+        The balls (``tailbeam.Ball``), positions (m) and velocities (m/s) in the plate
+        frame; names unique, centres above the plate and over it.
+    incline : InclinedPlate
+        The plate, its inclination and its edges.
+    duration : float
+        Simulated time (s), > 0.
+    damping, penetration, clamp, exponent : float, float, bool, float
+        The IMPACT parameters of every pair: damping c (N s/m), penetration d (m) where the
+        damping ramp ends, the clamp of negative forces, exponent e (stiffness from Hertz).
+    rtol : float
+        DOP853's relative tolerance in [1e-14, 1e-3] (atol = rtol x 1 mm on positions,
+        rtol x 1 m/s on velocities).
+    max_steps : int
+        Most DOP853 steps (WorkLimitError beyond).
+    release_times : sequence of float, optional
+        One per ball (s, default all 0): a ball enters the scene at its time, at its given
+        position and velocity (event ``release``; the energy series jumps there).
+    progress : callable, optional
+        Called with the time (s) reached after every accepted step.
+    plate : ReferencePlate, optional
+        The modal plate (two-way, ``tailbeam.solvers.stream.reference.plate``); None: the
+        rigid plate.
+    contacts : ContactTable, optional
+        The balls' contact table; its settings then replace the IMPACT parameters above.
+
+    Returns
+    -------
+    StreamReferenceResult
     """
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-3:
@@ -124,147 +182,60 @@ def simulate_stream_reference(
             raise InputError("plate", "must be a ReferencePlate (a modal basis and its damping)")
         plate.check_size(incline)
         _check_modal_work(plate, duration, max_steps)
-    sim = _Reference(balls, incline, options, rtol, max_steps, release, plate)
-    sim.progress = progress
-    return sim.run(duration)
+    _check_balls(balls, incline)
+    table = contact_table(balls, options, incline.plate.material)  # the pairs' laws
+    return _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, progress)
 
 
-class _Reference(ReferenceState, ReferenceEvents, ReferenceContacts, ReferenceSteps):
-    """The driver: DOP853 step by step, every step checked for events (module docstring)."""
+def _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, progress):
+    """Wire the parts (module docstring), run them and collect the result."""
+    mass = np.array([b.mass for b in balls])
+    present = [i for i in range(len(balls)) if release[i] <= 0.0]
+    waiting = sorted((float(release[i]), i) for i in range(len(balls)) if release[i] > 0)
+    layout = StateLayout(len(balls), None if plate is None else plate.n_modes, present)
+    pairs = PairSet(balls, table)
+    for i in present:
+        pairs.add_ball(i, present)
+    kinematics = Kinematics(layout, plate)
+    log = ContactLog(balls, plate)
+    changes = SceneChanges(layout, pairs, kinematics, log, balls, mass, rtol, waiting)
+    series = StepSeries(layout, pairs, kinematics, balls, mass, incline, plate)
+    search = EventSearch(pairs, layout, kinematics, incline, plate)
+    dynamics = Dynamics(layout, kinematics, pairs, mass, incline.gravity_vector, plate)
+    integrator = Integrator(dynamics, layout, plate, rtol)
+    loop = StepLoop(integrator, search, changes, series, max_steps, progress)
+    y = _initial_state(balls, present, plate)
+    changes.touch(list(pairs.values()), 0.0, y)
+    loop.run(0.0, y, duration)
+    for p in pairs.values():  # the contacts still in progress
+        p.write_peaks()
+    info = {
+        "solver": f"stream reference: scipy DOP853 rtol={rtol:g}, restarted at kinks",
+        "plate": "rigid"
+        if plate is None
+        else f"modal, two-way: {plate.n_modes} modes, {plate.shapes} shapes",
+        "duration": duration,
+    }
+    return StreamReferenceResult(
+        tuple(b.name for b in balls), mass, log.contacts, log.leaves, log.events,
+        np.array(series.times), np.array(series.energy), series.states, loop.steps, info,
+        series.plate_states,
+    )  # fmt: skip
 
-    def __init__(self, balls, incline, options, rtol, max_steps, release, plate=None):
-        _check_balls(balls, incline)
-        self.plate, self.h_cap = plate, math.inf
-        self.trial_errors = {} if plate is None else dict(over="ignore", invalid="ignore")
-        self.balls, self.incline, self.rtol, self.max_steps = balls, incline, rtol, max_steps
-        self.g = incline.gravity_vector
-        self.mass = np.array([b.mass for b in balls])
-        self.table = contact_table(balls, options, incline.plate.material)  # the pairs' laws
-        self.active = [i for i in range(len(balls)) if release[i] <= 0.0]
-        self.waiting = sorted((float(release[i]), i) for i in range(len(balls)) if release[i] > 0)
-        self.pairs = {}
-        for i in self.active:
-            self.add_pairs(i)
-        self.contacts, self.leaves, self.events = [], [], []
-        self.times, self.energy, self.states, self.plate_states = [], [], [], []
-        self.steps = 0
-        self.progress = None
-        pos = np.array([balls[i].position for i in self.active], dtype=float).reshape(-1, 3)
-        vel = np.array([balls[i].velocity for i in self.active], dtype=float).reshape(-1, 3)
-        m = 0 if plate is None else plate.n_modes
-        self.y = self.join(pos, vel, (np.zeros(m), np.zeros(m)) if m else None)
-        self.t = 0.0
-        self.touch(list(self.pairs.values()), 0.0)
 
-    # --- main loop ------------------------------------------------------------------------
-    def run(self, duration):
-        fresh, pending, h0 = set(), None, None
-        t_bound = self.next_stop(duration)
-        solver = self.new_solver(self.t, self.y, t_bound, h0)
-        self.record_step(self.t, self.y)
-        while True:
-            if solver.status == "finished":
-                if pending is None and solver.t >= duration:
-                    break
-                if pending is None:  # a release time
-                    fresh, h0 = set(), self.release_due(solver.t, solver.y)
-                else:
-                    fresh, h0 = self.finish_redo(pending[0], solver.t, solver.y)
-                pending, t_bound = None, self.next_stop(duration)
-                self.h_cap = math.inf
-                solver = self.new_solver(self.t, self.y, t_bound, h0)
-                continue
-            t0, y0 = solver.t, solver.y.copy()
-            with np.errstate(**self.trial_errors):  # (see make_modal_rhs)
-                message = solver.step()
-            if solver.status == "failed":
-                raise RuntimeError(f"stream reference: DOP853 failed: {message}")
-            self.steps += 1
-            if self.steps > self.max_steps:
-                raise WorkLimitError(
-                    f"stream reference: more than max_steps={self.max_steps} steps by "
-                    f"t = {t0:.6g} s; raise max_steps or shorten the duration"
-                )
-            dense, t1 = solver.dense_output(), solver.t
-            if self.too_far(dense, t0, t1):  # modal plate: the step bound of the gap rows
-                self.h_cap = 0.5 * (t1 - t0)
-                solver = self.new_solver(t0, y0, t_bound, self.h_cap)
-                continue
-            found = self.detect(dense, t0, t1, fresh)
-            if found is not None and pending and found[1] >= pending[1] - SAME_TIME * (t1 - t0):
-                found = None  # (about) simultaneous with the pending event: taken after it
-            if found is None:
-                self.accept(dense, t0, t1)
-                self.record_step(t1, solver.y)
-                if self.progress is not None:
-                    self.progress(t1)
-                fresh = set() if t1 > t0 else fresh
-                continue
-            row, t_e = found
-            if t_e <= t0 + 4.0 * np.spacing(t0):  # at the restart (to round-off): apply there
-                h0 = self.apply(row[0], t0, y0)
-                fresh = fresh | {row[0]}
-                pending, t_bound = None, self.next_stop(duration)
-            else:  # redo the step so that it ends exactly at the event
-                self.t, self.y = t0, y0
-                pending, t_bound, h0 = (row, t_e), t_e, t_e - t0
-            solver = self.new_solver(self.t, self.y, t_bound, h0)
-        self.finish()
-        return self.result(duration)
-
-    def finish_redo(self, row, t, y):
-        """At the end of a redone step: apply the event if its row is within its dead band
-        of the crossing; otherwise (the discarded step, which straddled the kink, placed the
-        root early) go on from here: the next step finds it again, closer. Returns the
-        fresh set and the next first step."""
-        x, v = self.split(y)
-        key, sign, _, band = row
-        modes = self.modes(y[None])
-        if sign * self.row_values([row], x[None], v[None], modes)[0, 0] <= band:
-            return {key}, self.apply(key, t, y)
-        self.t, self.y = t, y
-        return set(), None
-
-    def new_solver(self, t, y, t_bound, h0):
-        self.t, self.y = t, y
-        n = len(self.active)  # atol: rtol x 1 mm on positions, rtol x 1 m/s on velocities
-        atol = self.rtol * np.concatenate([np.full(3 * n, 1e-3), np.ones(3 * n)])
-        if self.plate is not None:
-            atol = np.concatenate([atol, self.plate.atol(self.rtol)])
-        if h0 is not None:
-            h0 = min(h0, t_bound - t) if t_bound > t else None
-        return DOP853(self.make_rhs(), t, y, t_bound, rtol=self.rtol, atol=atol, first_step=h0,
-                      max_step=self.h_cap)  # fmt: skip
-
-    def too_far(self, dense, t0, t1) -> bool:
-        """Modal plate: whether a ball moved more than 1 / k_max sideways on the step (k_max:
-        the top mode's wavenumber). Below it the mode shapes along the path are so smooth that
-        the 15-point interpolant of the plate gap rows is exact to round-off (module
-        docstring); the step is then redone shorter."""
-        if self.plate is None or t1 <= t0 or not self.active:
-            return False
-        x = self.states_at(dense, t0 + STEP_POINTS * (t1 - t0))[0]
-        travel = np.max(np.linalg.norm(x[:, :, :2] - x[:1, :, :2], axis=-1))
-        return bool(self.plate.k_max * travel > 1.0)
-
-    def result(self, duration):
-        info = {
-            "solver": f"stream reference: scipy DOP853 rtol={self.rtol:g}, restarted at kinks",
-            "plate": "rigid"
-            if self.plate is None
-            else f"modal, two-way: {self.plate.n_modes} modes, {self.plate.shapes} shapes",
-            "duration": duration,
-        }
-        return StreamReferenceResult(
-            tuple(b.name for b in self.balls), self.mass, self.contacts, self.leaves,
-            self.events, np.array(self.times), np.array(self.energy), self.states,
-            self.steps, info, self.plate_states,
-        )  # fmt: skip
+def _initial_state(balls, present, plate):
+    """The state vector at t = 0: the present balls' positions and velocities, the plate at
+    rest."""
+    pos = np.array([balls[i].position for i in present], dtype=float).reshape(-1, 3)
+    vel = np.array([balls[i].velocity for i in present], dtype=float).reshape(-1, 3)
+    m = 0 if plate is None else plate.n_modes
+    return StateLayout.join(pos, vel, (np.zeros(m), np.zeros(m)) if m else None)
 
 
 def _check_modal_work(plate, duration, max_steps):
     """The modes bound the steps: at least MODAL_STEPS_PER_PERIOD per period of the top mode
-    (measured 9-20 at rtol 1e-12); refuse a run that cannot fit max_steps before it starts."""
+    (a lower bound: DOP853 takes more at the tolerances used); refuse a run that cannot fit
+    max_steps before it starts."""
     estimate = MODAL_STEPS_PER_PERIOD * duration * float(np.max(plate.omega)) / (2.0 * math.pi)
     if estimate > max_steps:
         raise WorkLimitError(
@@ -275,6 +246,7 @@ def _check_modal_work(plate, duration, max_steps):
 
 
 def _release_times(release_times, n):
+    """The release times (s) as an array of n, zeros if None (InputError if invalid)."""
     if release_times is None:
         return np.zeros(n)
     times = np.asarray(release_times, dtype=float)
@@ -284,6 +256,7 @@ def _release_times(release_times, n):
 
 
 def _check_balls(balls, incline):
+    """Names unique, centres above the plate and over it (InputError otherwise)."""
     names = set()
     for b in balls:
         field_ = f"balls[{b.name}]"

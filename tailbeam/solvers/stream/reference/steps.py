@@ -1,10 +1,7 @@
 """What an accepted step of the stream reference records: its contacts' peak force and
-maximum penetration, the total energy and the states (a mixin of
-``tailbeam.solvers.stream.reference.solver._Reference``, which provides ``pairs``,
-``active``, ``mass``, ``incline``, ``plate``, ``balls``, the step series ``times``,
-``energy``, ``states``, ``plate_states`` and the state layout of ``reference_state``).
+largest penetration, and the step series (time, total energy, states).
 
-Peak force and maximum penetration: the maximum of their Chebyshev interpolant on each step
+Peak force and largest penetration: the maximum of their Chebyshev interpolant on each step
 (``tailbeam.solvers.numerics.step_events.interpolant_max``).
 """
 
@@ -12,18 +9,50 @@ import numpy as np
 
 from tailbeam.physics.contact_law import elastic_energy, impact_force_in_region
 from tailbeam.solvers.numerics.step_events import STEP_POINTS, interpolant_max
-from tailbeam.solvers.stream.reference.state import _law_table
+from tailbeam.solvers.stream.reference.pairs import law_table
 
 
-class ReferenceSteps:
-    """Peaks, energy and states of the accepted steps of the stream reference."""
+class StepSeries:
+    """Per accepted step: ``times`` (s), total ``energy`` (J), ``states`` (names of the balls
+    present, positions (n, 3) m, velocities (n, 3) m/s) and, on the modal plate,
+    ``plate_states`` ((q, q')); and the peaks of the contacts in progress.
 
-    def accept(self, dense, t0, t1):
-        """Update the peak force and maximum penetration of the contacts on [t0, t1]."""
-        pairs = [p for p in self.pairs.values() if p.in_contact]
+    Parameters
+    ----------
+    layout : StateLayout
+        Which balls are present.
+    pairs : PairSet
+        The watched pairs.
+    kinematics : Kinematics
+        The pairs' contact kinematics.
+    balls : list of Ball
+        The scene's balls (names).
+    mass : ndarray
+        Mass of every ball (kg).
+    incline : InclinedPlate
+        Gravity's potential energy.
+    plate : ReferencePlate or None
+        The modal plate (its energy), or None for the rigid plate.
+    """
+
+    def __init__(self, layout, pairs, kinematics, balls, mass, incline, plate):
+        self.layout = layout
+        self.pairs = pairs
+        self.kinematics = kinematics
+        self.names = [b.name for b in balls]
+        self.mass = mass
+        self.incline = incline
+        self.plate = plate
+        self.times, self.energy, self.states, self.plate_states = [], [], [], []
+
+    def update_peaks(self, dense, t0, t1) -> None:
+        """Update the peak force and largest penetration of the contacts on the accepted step
+        [t0, t1] (s) with dense output ``dense``."""
+        pairs = self.pairs.in_contact()
         if not pairs or t1 <= t0:
             return
-        force, delta = self.pair_forces(pairs, *self.states_at(dense, t0 + STEP_POINTS * (t1 - t0)))
+        states = self.layout.states_at(dense, t0 + STEP_POINTS * (t1 - t0))
+        force, delta = self.pair_forces(pairs, *states)
         # Refined only where the node maximum comes within 1 % of the record so far: between
         # nodes the interpolant cannot exceed them by more (a step resolved to rtol 1e-12
         # spans ~(1e-12)^(1/8) of the force's time scale; the overshoot is ~1e-6).
@@ -38,8 +67,8 @@ class ReferenceSteps:
     def pair_forces(self, pairs, x, v, modes=None):
         """Force (N) and penetration (m) of ``pairs`` at states x, v (K, n, 3) (and modes):
         (P, K) each."""
-        kin, _, _, _ = self.kinematics(pairs, x, v, modes)
-        laws = _law_table(pairs)
+        kin, _, _, _ = self.kinematics.of(pairs, x, v, modes)
+        laws = law_table(pairs)
         ramp = np.array([p.ramp for p in pairs])
         clamped = np.array([p.clamped for p in pairs])
         k = x.shape[0]
@@ -48,32 +77,29 @@ class ReferenceSteps:
         force = impact_force_in_region(delta, rate, laws, ramp, clamped)
         return force.T, delta.T
 
-    def total_energy(self, y):
-        """Kinetic + gravitational + elastic energy in J of the active balls at state y."""
-        x, v = self.split(y)
-        m = self.mass[self.active]
+    def total_energy(self, y) -> float:
+        """Kinetic + gravitational + elastic (+ modal) energy (J) at state vector y."""
+        x, v = self.layout.split(y)
+        m = self.mass[self.layout.active]
         energy = 0.5 * float(np.sum(m[:, None] * v * v))
         energy += self.incline.potential_energy(m, x)
-        modes = self.modes(y)
+        modes = self.layout.modes(y)
         if modes is not None:
             energy += self.plate.energy(*modes)
             modes = tuple(a[None] for a in modes)
-        pairs = [p for p in self.pairs.values() if p.in_contact]
+        pairs = self.pairs.in_contact()
         if pairs:
-            kin, _, _, _ = self.kinematics(pairs, x[None], v[None], modes)
-            energy += float(np.sum(elastic_energy(kin.penetration, _law_table(pairs))))
+            kin, _, _, _ = self.kinematics.of(pairs, x[None], v[None], modes)
+            energy += float(np.sum(elastic_energy(kin.penetration, law_table(pairs))))
         return energy
 
-    def record_step(self, t, y):
+    def record(self, t, y) -> None:
+        """Append the step ending at time t (s) with state vector y to the series."""
         self.times.append(t)
         self.energy.append(self.total_energy(y))
-        x, v = self.split(y)
-        names = tuple(self.balls[b].name for b in self.active)
+        x, v = self.layout.split(y)
+        names = tuple(self.names[b] for b in self.layout.active)
         self.states.append((names, x.copy(), v.copy()))
-        if self.plate is not None:
-            self.plate_states.append(tuple(a.copy() for a in self.modes(y)))
-
-    def finish(self):
-        for p in self.pairs.values():
-            for rec in p.records:
-                rec.peak_force, rec.t_peak, rec.max_penetration = p.peak, p.t_peak, p.pen
+        modes = self.layout.modes(y)
+        if modes is not None:
+            self.plate_states.append(tuple(a.copy() for a in modes))

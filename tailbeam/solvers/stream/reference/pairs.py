@@ -1,0 +1,136 @@
+"""The watched pairs of the stream reference: every ball with the plate and with every other
+present ball, each with its law, its region flags and its open contact records.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tailbeam.physics.contact_law import ImpactLaw
+from tailbeam.physics.contacts import PLATE
+
+
+@dataclass
+class Pair:
+    """A watched pair: ball ``i`` and ball ``j`` (``j = -1``: the plate).
+
+    Parameters
+    ----------
+    i, j : int
+        Indices into the scene's balls, i < j for two balls; j = -1 for the plate.
+    law : ImpactLaw
+        The pair's contact law.
+    radius_sum : float
+        r_i + r_j (m); r_i for the plate.
+    in_contact, ramp, clamped : bool
+        The region: in contact; penetration below d (the STEP ramp of the damping);
+        force clamped at zero.
+    records : list of Impact
+        The open contact's records (one per ball), empty out of contact.
+    peak, t_peak, pen : float
+        The open contact's largest force (N), its time (s) and largest penetration (m).
+    phi0 : ndarray or None
+        Mode shapes (1/sqrt(kg)) kept by a frozen plate contact (modal plate), else None.
+    """
+
+    i: int
+    j: int
+    law: ImpactLaw
+    radius_sum: float
+    in_contact: bool = False
+    ramp: bool = True
+    clamped: bool = False
+    records: list = field(default_factory=list)
+    peak: float = 0.0
+    t_peak: float = math.nan
+    pen: float = 0.0
+    phi0: np.ndarray | None = None
+
+    @property
+    def kinked(self) -> bool:
+        """Whether the law has a STEP kink at delta = d (it does only with damping)."""
+        return self.law.damping > 0.0
+
+    def start(self, records, penetration, phi0=None) -> None:
+        """Open a contact with its ``records`` (``Impact``, one per ball) at ``penetration``
+        (m; 0 if negative), in the ramp region, unclamped; ``phi0``: the mode shapes a
+        frozen plate contact keeps."""
+        self.in_contact, self.ramp, self.clamped = True, True, False
+        self.peak, self.t_peak, self.pen = 0.0, math.nan, max(0.0, penetration)
+        self.records, self.phi0 = records, phi0
+
+    def stop(self) -> None:
+        """Close the contact: its peaks go into its records, which it then lets go."""
+        self.write_peaks()
+        self.in_contact, self.records, self.phi0 = False, [], None
+
+    def write_peaks(self) -> None:
+        """Copy the peak force, its time and the largest penetration into the records."""
+        for rec in self.records:
+            rec.peak_force, rec.t_peak, rec.max_penetration = self.peak, self.t_peak, self.pen
+
+
+class PairSet:
+    """The watched pairs by key (i, j), in the order they were created.
+
+    Parameters
+    ----------
+    balls : list of Ball
+        The scene's balls (their radii, m).
+    table : ContactTable
+        The laws of every pair of the scene.
+    """
+
+    def __init__(self, balls, table):
+        self.balls = balls
+        self.table = table
+        self.pairs = {}
+
+    def __getitem__(self, key) -> Pair:
+        return self.pairs[key]
+
+    def items(self):
+        return self.pairs.items()
+
+    def values(self):
+        return self.pairs.values()
+
+    def in_contact(self) -> list:
+        """The pairs in contact, in creation order."""
+        return [p for p in self.pairs.values() if p.in_contact]
+
+    def add_ball(self, i: int, present) -> list:
+        """Create the pairs of ball i with the plate and with every other ball of ``present``
+        (indices) that has none yet; returns the pairs of ball i with those."""
+        a, made = self.balls[i], []
+        law = self.table.law(i, PLATE)
+        made.append(self.pairs.setdefault((i, -1), Pair(i, -1, law, a.radius)))
+        for j in present:
+            if j != i:
+                lo, hi = min(i, j), max(i, j)
+                b, c = self.balls[lo], self.balls[hi]
+                pair = Pair(lo, hi, self.table.law(lo, hi), b.radius + c.radius)
+                made.append(self.pairs.setdefault((lo, hi), pair))
+        return made
+
+    def drop_ball(self, ball: int) -> list:
+        """Remove and return the pairs of ``ball``, in creation order."""
+        return [self.pairs.pop(key) for key in [key for key in self.pairs if ball in key]]
+
+
+@dataclass
+class Laws:
+    """ImpactLaw parameters as arrays over pairs (duck-types ImpactLaw for the law helpers):
+    stiffness (N/m^e), exponent, damping (N s/m) and penetration d (m)."""
+
+    stiffness: np.ndarray
+    exponent: np.ndarray
+    damping: np.ndarray
+    penetration: np.ndarray
+
+
+def law_table(pairs) -> Laws:
+    """The laws of ``pairs`` (a list of ``Pair``) as arrays."""
+    return Laws(*(np.array([getattr(p.law, a) for p in pairs], dtype=float)
+                  for a in ("stiffness", "exponent", "damping", "penetration")))  # fmt: skip
