@@ -76,6 +76,15 @@ class Balls:
         """Indices of the balls moving in closed form (FLY or SLIDE)."""
         return np.flatnonzero((self.status == FLY) | (self.status == SLIDE))
 
+    def resting(self, t: float):
+        """(xy (p, 2) m, weights (p,) N) of the balls resting on the plate outside the
+        active set (SLIDE) at time t (s)."""
+        idx = np.flatnonzero((self.status == SLIDE) & ~self.in_set)
+        if not len(idx):
+            return np.empty((0, 2)), np.empty(0)
+        x, _ = self.states(idx, t)
+        return x[:, :2], self.mass[idx] * -self.g[2]
+
     def speed_bounds(self, idx, t: float, horizon: float) -> np.ndarray:
         """Bounds (m/s) on the speeds of closed-form balls ``idx`` over [t, t + horizon]."""
         _, v = self.states(idx, t)
