@@ -18,7 +18,18 @@ PENDING, FLY, SLIDE, ACTIVE, GONE = range(5)
 
 
 class Balls:
-    """Per-ball arrays of a stream (n balls, in release order)."""
+    """Per-ball arrays of a stream (n balls, in release order).
+
+    Parameters
+    ----------
+    particles : list of Particle
+        The stream's particles (name, mass kg, radius m, t_release s, position m, velocity
+        m/s in the plate frame).
+    incline : InclinedPlate
+        The plate (half sizes m) and gravity (m/s^2, plate frame).
+    contacts : ContactTable
+        The particles' contact laws.
+    """
 
     def __init__(self, particles, incline, contacts):
         self.particles = list(particles)

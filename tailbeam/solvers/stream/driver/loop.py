@@ -59,14 +59,36 @@ STUCK_LIMIT = 5_000  # loop rounds without time moving before the run is stopped
 
 @dataclass
 class StreamRun:
-    """What the stream solver found (``tailbeam.solvers.stream.stream_result`` presents it)."""
+    """What the stream solver found (``tailbeam.solvers.stream.stream_result`` presents it).
 
-    particles: list  # as released (a release onto a rebounding ball is postponed)
+    Attributes
+    ----------
+    particles : list of Particle
+        The particles as released (a release onto a rebounding ball is postponed).
+    contacts : list of Impact
+        One record per ball per contact, in order of start and ball; ``end`` an ``End``.
+    leaves : list of LeaveEvent
+        The balls that left the plate over an edge.
+    events : list of Event
+        Every event in time order.
+    loads : list of tuple
+        (x m, y m, t_nodes (k,) s, forces (k,) N): plate contact force histories.
+    dead_loads : list of tuple
+        (x m, y m, t_from s, t_to s, force N): the sliders' weight on the plate.
+    status : int
+        0: the end of the simulated time was reached.
+    message : str
+        What ``status`` means.
+    stats : dict
+        Work counters and the energy ledger (J).
+    """
+
+    particles: list
     contacts: list
     leaves: list
     events: list
-    loads: list  # (x, y, t_nodes, forces): plate contact force histories (m, s, N)
-    dead_loads: list  # (x, y, t_from, t_to, force): sliders' weight on the plate
+    loads: list
+    dead_loads: list
     status: int
     message: str
     stats: dict = field(default_factory=dict)
@@ -88,13 +110,39 @@ def solve_stream(
     plate=None,
     contacts=None,
 ) -> StreamRun:
-    """Simulate ``particles`` (``tailbeam.streams.generator.Particle``: released at their
-    t_release with their position and velocity, plate frame) on ``incline`` for ``duration``
-    s. IMPACT parameters shared by every pair (stiffness from Hertz for each pair); rtol: the
-    kernel's relative tolerance; rest_speed (m/s): see the module docstring; max_work: bound
-    on kernel steps plus events (WorkLimitError beyond); plate: a ``StreamPlate`` (the modal
-    plate, two-way) or None (the rigid plate); contacts: the particles' ``ContactTable``
-    (its settings then replace the IMPACT parameters given here)."""
+    """Simulate a stream of particles on an inclined plate.
+
+    Parameters
+    ----------
+    particles : list of Particle
+        ``tailbeam.streams.generator.Particle``: released at their t_release (s) with their
+        position (m) and velocity (m/s), plate frame.
+    incline : InclinedPlate
+        The plate and gravity.
+    duration : float
+        Simulated time (s).
+    damping, penetration, clamp, exponent : float, float, bool, float
+        IMPACT parameters shared by every pair: damping c (N s/m), full-damping penetration
+        d (m), the clamp, Hertz exponent (stiffness from Hertz for each pair).
+    rtol : float
+        The active set's relative tolerance, in [1e-14, 1e-4].
+    rest_speed : float
+        Speed (m/s) below which a plate contact ends at rest (see the module docstring).
+    max_work : int
+        Bound on kernel steps plus events (``WorkLimitError`` beyond).
+    progress : bool or callable
+        Show a progress bar, or a callable told the simulated time reached (s).
+    plate : StreamPlate, optional
+        The two-way modal plate (None: the rigid plate).
+    contacts : ContactTable or LawOptions, optional
+        The particles' contact laws (their settings then replace the IMPACT parameters).
+
+    Returns
+    -------
+    StreamRun
+        The records, loads and counters (``stats["rtol"]``: the tolerance used; it is
+        tightened when contacts stall at one instant).
+    """
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-4:
         raise InputError("rtol", f"must lie in [1e-14, 1e-4], got {rtol!r}")

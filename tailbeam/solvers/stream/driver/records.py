@@ -22,8 +22,8 @@ class ContactRecords:
     ----------
     balls : Balls
         The stream's balls (names, radii, plate laws).
-    act : ActiveSet
-        The active set (``ActiveMembers``: its members' states and pair accumulators).
+    act : ActiveMembers
+        The active set (its members' states and pair accumulators).
     clock : Clock
         The driver's time.
     rest_speed : float
