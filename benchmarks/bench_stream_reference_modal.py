@@ -41,7 +41,7 @@ from test_stream_solver import _particles, _worst_difference  # noqa: E402
 from tailbeam.physics.bodies import Plate  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
-from tailbeam.solvers.stream.active import members as active_members  # noqa: E402
+from tailbeam.solvers.stream.active import shapes as active_shapes  # noqa: E402
 from tailbeam.solvers.stream.driver import loop as stream  # noqa: E402
 from tailbeam.solvers.stream.driver import membership as stream_membership  # noqa: E402
 from tailbeam.solvers.stream.plate import StreamPlate  # noqa: E402
@@ -55,7 +55,7 @@ SCENES = {
 }
 GRAZE = 0.01  # contacts with a peak force below this fraction of the largest are grazes
 REFRESH = (1e-4, 1e-5, 1e-6)  # m: shape refresh and reuse distances of the fast solver
-DEFAULTS = (stream_membership.SHAPE_TRAVEL, active_members.SHAPE_REUSE)
+DEFAULTS = (stream_membership.SHAPE_TRAVEL, active_shapes.SHAPE_REUSE)
 DEFAULT_MARKERS = (  # (column, marker, style, legend) of the fast solver at its defaults
     ("vs_frozen", "s", dict(ms=8, mfc="none"), "fast (defaults) vs frozen reference"),
     ("vs_exact", "x", dict(ms=9, mew=2), "fast (defaults) vs exact reference"),
@@ -74,7 +74,7 @@ def reference(scene, basis, law, shapes, rtol=1e-12):
 def fast(scene, basis, law, refresh=None):
     """The fast solver, its shape distances at ``refresh`` (None: its defaults)."""
     travel, reuse = DEFAULTS if refresh is None else (refresh, refresh)
-    stream_membership.SHAPE_TRAVEL, active_members.SHAPE_REUSE = travel, reuse
+    stream_membership.SHAPE_TRAVEL, active_shapes.SHAPE_REUSE = travel, reuse
     try:
         balls, incline = scene
         plate = StreamPlate(basis, np.full(basis.n_modes, ZETA), residual_flexibility=False)
@@ -83,7 +83,7 @@ def fast(scene, basis, law, refresh=None):
                                   rest_speed=0.0, progress=False, plate=plate, **law)  # fmt: skip
         return run, time.perf_counter() - t
     finally:
-        stream_membership.SHAPE_TRAVEL, active_members.SHAPE_REUSE = DEFAULTS
+        stream_membership.SHAPE_TRAVEL, active_shapes.SHAPE_REUSE = DEFAULTS
 
 
 def _impacts(ref, other):

@@ -25,7 +25,7 @@ from tailbeam.physics.bodies import Plate
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import CARBON_STEEL
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
-from tailbeam.solvers.stream.active import members as active_members
+from tailbeam.solvers.stream.active import shapes as active_shapes
 from tailbeam.solvers.stream.driver import loop as stream
 from tailbeam.solvers.stream.driver import membership as stream_membership
 from tailbeam.solvers.stream.plate import StreamPlate
@@ -106,7 +106,7 @@ def _fast(scene, basis, law, travel=None, monkeypatch=None):
     ``travel``, test-only)."""
     if travel is not None:
         monkeypatch.setattr(stream_membership, "SHAPE_TRAVEL", travel)
-        monkeypatch.setattr(active_members, "SHAPE_REUSE", travel)
+        monkeypatch.setattr(active_shapes, "SHAPE_REUSE", travel)
     balls, incline = scene
     plate = StreamPlate(basis, np.full(basis.n_modes, ZETA), residual_flexibility=False)
     run = stream.solve_stream(_particles(balls), incline, SCENE_DURATION, rtol=1e-12,

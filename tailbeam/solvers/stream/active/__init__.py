@@ -1,4 +1,7 @@
 """The active set: the balls in contact and their neighbours, integrated by a compiled DOP853
 with every kink of the law located as an event (``kernel``, ``step``, ``events``, ``fresh``,
 ``pairs``), its Python wrapper (``set``, ``modal_block``) and the driver's view of it by ball
-and pair key (``members``, ``tails``)."""
+and pair key (``members``) with its parts: the fresh rows carried across rebuilds
+(``carry``), the plate force histories (``forces``), putting a member at rest (``rest``) and
+the modal plate's pairs (``plate_pairs``: mode shapes (``shapes``), residual compliance and
+contact tails (``tails``))."""

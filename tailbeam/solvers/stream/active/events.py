@@ -3,10 +3,10 @@
 Every watched row (pairs: contact, full damping, clamp; balls: the 4 edges) is certified in
 three tiers: the bound B on how far each state component moves in the step (``prepare``,
 ``_quick``: O(1) for far pairs and balls far from the edges), else the 15 Chebyshev values of
-the row (the ball's dense output there, ``active_step.ensure_ball``), else the first-crossing
-search (``cheb_events``). Rows that are no polynomial on the step (the clamp indicator, the
-law's delta with residual flexibility) are sampled at the 15 points and closed by Illinois
-(``_sampled_crossing``). ``detect`` returns the earliest crossing of all rows.
+the row (the ball's dense output there, ``step.ensure_ball``), else the first-crossing search
+(``tailbeam.solvers.numerics.chebyshev``). Rows that are no polynomial on the step (the clamp
+indicator, the law's delta with residual flexibility) are sampled at the 15 points and closed by
+Illinois (``_sampled_crossing``). ``detect`` returns the earliest crossing of all rows.
 """
 
 import math
@@ -126,7 +126,7 @@ def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, 
                   rsum, touching, ramp, clamped, vals, wc, wv, wc2, wd, stack, tmp, model,
                   pstate, W15, have_w, proj):  # fmt: skip
     """First crossing (fraction of the step, inf if none) of row (kind, idx): the bound B,
-    else the 15-point certificate, else the search (``cheb_events``)."""
+    else the 15-point certificate, else the search (``tailbeam.solvers.numerics.chebyshev``)."""
     phi = model[12]
     if _quick(kind, idx, y, B, n, half, pi, pj, law, rsum, touching, ramp, phi):
         return math.inf

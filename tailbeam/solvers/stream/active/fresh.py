@@ -1,10 +1,11 @@
 """Rows of an active set whose events were just applied ("fresh"), carried across returns.
 
-An event the active-set kernel (``active_kernel``) applies leaves its row's function on 0 at
-that instant. The kernel keeps such rows in a small table (kind, index), at most MAX_FRESH,
-searched from ``cheb_events.FRESH_S`` of the next step on, and hands the rows applied at the
-instant it returns at to the next call that starts there (``active_set.ActiveSet.advance``),
-so a START or END it returned is not found again at once (the grazing stall of issue 7).
+An event the active-set kernel (``kernel``) applies leaves its row's function on 0 at that
+instant. The kernel keeps such rows in a small table (kind, index), at most MAX_FRESH, searched
+from ``tailbeam.solvers.numerics.chebyshev.FRESH_S`` of the next step on, and hands the rows
+applied at the instant it returns at to the next call that starts there
+(``set.ActiveSet.advance``), so a START or END it returned is not found again at once (a grazing
+contact would stall).
 """
 
 from tailbeam.solvers.numerics.chebyshev import FRESH_S

@@ -4,36 +4,37 @@ One call advances the state from t until the first structural event or t_stop (s
 ``advance``). Per step: 12 + 3 right-hand-side evaluations (O(balls + touching pairs) each)
 and every watched row (pairs and edges: O(pairs watched + balls)) certified in three tiers:
 the bound B on how far each state component moves in the step, else the 15 Chebyshev values
-of the row, else the first-crossing search (``active_events``). Helpers take arrays one by one
+of the row, else the first-crossing search (``events``). Helpers take arrays one by one
 and are compiled without reference counting (``tailbeam.solvers.numerics.jit``); only
 ``advance`` and ``_workspaces`` allocate. Modules: the step and its dense output
-(``active_step``), the event search (``active_events``), and here the loop and its
+(``step``), the event search (``events``), and here the loop and its
 bookkeeping (peaks, force rows, applying events, settling).
 
-With the optional modal plate (m modes after the balls in the state, ``active_pairs``) the
+With the optional modal plate (m modes after the balls in the state, ``pairs``) the
 plate's deflection under a plate pair at the 15 points and at the force-row nodes comes from
-the modes projected on that pair's phi first (``active_step.project``: O(m) per pair and
+the modes projected on that pair's phi first (``step.project``: O(m) per pair and
 step); the far-pair bound adds sum |phi_k| B_k; the error norm is taken per block (balls,
 modes). Without modes every operation and result is the rigid plate's, bit for bit. With
-residual flexibility at a plate pair (``active_pairs.plate_force_with_residual``) its
+residual flexibility at a plate pair (``pairs.plate_force_with_residual``) its
 full-damping row, like the clamp row, is sampled at the 15 points and closed by Illinois
 (the law's delta is no polynomial on the step); the contact row stays the polynomial gap.
 
-Event handling is the reference's (``stream_reference``): a step in which a row crosses is
-discarded and redone to end exactly at the crossing, and the redone step is checked again
-(an earlier root wins). At the end of the redone step the event is applied if its row is
-within its dead band of the crossing. Kinks (full damping d crossed, clamp on/off) are
-applied inside (logged) and integration goes on in the new region; contact start / end,
-leave, settle return to the caller. Events within ``SAME_TIME`` of a step of a pending one
-are taken after it, one after the other at the same time (a symmetric 3-ball cluster).
-A row whose event was just applied sits on 0 at the restart ("fresh": searched from
-``cheb_events.FRESH_S`` on in the next step); the fresh rows are handed back on return and
-carried into the next call that starts at that instant (``active_set.ActiveSet.advance``;
-the stream driver carries them into a set rebuilt then, ``active_members``). A carried row
-whose crossing is found at the restart instant while it is back on its side at FRESH_S is
-searched again as fresh (``active_fresh.found_again``): a START or END returned to the caller is not
-applied again at once where its row sat on 0 (the grazing stall of issue 7); a row still on
-its wrong side there, and a genuine new crossing later in the step, are found as before.
+Event handling is the reference's (``tailbeam.solvers.stream.reference``): a step in which a row
+crosses is discarded and redone to end exactly at the crossing, and the redone step is checked
+again (an earlier root wins). At the end of the redone step the event is applied if its row is
+within its dead band of the crossing. Kinks (full damping d crossed, clamp on/off) are applied
+inside (logged by their ``EventCode``) and integration goes on in the new region; contact start
+/ end, leave and a settled plate contact (``EventCode.REST``) return to the caller. Events
+within ``SAME_TIME`` of a step of a pending one are taken after it, one after the other at the
+same time (a symmetric 3-ball cluster). A row whose event was just applied sits on 0 at the
+restart ("fresh": searched from ``tailbeam.solvers.numerics.chebyshev.FRESH_S`` on in the next
+step); the fresh rows are handed back on return and carried into the next call that starts at
+that instant (``set.ActiveSet.advance``; the stream driver carries them into a set rebuilt then,
+``members``). A carried row whose crossing is found at the restart instant while it is back on
+its side at FRESH_S is searched again as fresh (``fresh.found_again``): a START or END returned
+to the caller is not applied again at once where its row sat on 0 (a grazing contact would stall
+at one instant); a row still on its wrong side there, and a genuine new crossing later in the
+step, are found as before.
 """
 
 import math
@@ -41,7 +42,7 @@ import math
 import numpy as np
 from numba import njit
 
-from tailbeam.results.records import EventKind
+from tailbeam.results.records import EventCode
 from tailbeam.solvers.numerics.chebyshev import interpolant_max
 from tailbeam.solvers.numerics.dop853 import growth, shrink
 from tailbeam.solvers.numerics.jit import helper_njit
@@ -71,15 +72,11 @@ from tailbeam.solvers.stream.active.step import (
     project_plate,
 )
 
-# return status of ``advance``
-ST_STOP, ST_START, ST_END, ST_LEAVE, ST_SETTLE, ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = range(8)
-STATUS_NAMES = (
-    "t_stop", "contact_start", "contact_end", "leave", "settle", "buffer_full", "step_limit",
-    "step_too_small",
-)  # fmt: skip
-# kinds in the event log
-LOG_FULL, LOG_CLAMP_ON, LOG_CLAMP_OFF = range(3)
-LOG_NAMES = (EventKind.FULL_DAMPING, EventKind.CLAMP_ON, EventKind.CLAMP_OFF)
+# What ``advance`` returns with (iout[IO_STATUS]): the ``EventCode`` of the event it stopped at
+# (CONTACT_START, CONTACT_END, LEAVE; REST: a ball's plate contact settled; NONE: t_stop
+# reached), or why it stopped early (private, never an event):
+ST_BUFFER, ST_STEP_LIMIT, ST_STEP_TINY = 100, 101, 102  # a buffer is full, max_steps, h -> 0
+# The kink log's kinds are the EventCode of each kink (FULL_DAMPING, CLAMP_ON, CLAMP_OFF).
 # integer outputs (iout); IO_FRESH: the rows in ``fresh`` (in/out, see ``advance``);
 # IO_AGAIN: events found again at the instant they were applied (searched again; counted)
 IO_STATUS, IO_INDEX, IO_EDGE, IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_ROWS, IO_LOG = range(8)
@@ -178,14 +175,15 @@ def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj):
 @helper_njit
 def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
     """Apply the event of row (kind, idx) at time t, state y; returns the status to return
-    with (ST_START, ST_END, ST_LEAVE) or -1 for a kink handled here (logged)."""
+    with (EventCode.CONTACT_START, CONTACT_END, LEAVE) or EventCode.NONE for a kink handled
+    here (logged)."""
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
     touching, ramp, clamped, peak, t_peak, pen = pstate
     n = mass.shape[0]
     if kind == R_EDGE:
         iout[IO_INDEX] = idx // 4
         iout[IO_EDGE] = idx % 4
-        return ST_LEAVE
+        return EventCode.LEAVE
     iout[IO_INDEX] = idx
     if kind == R_CONTACT:
         f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi, mass, g, omega, zeta,
@@ -194,7 +192,7 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
             if pj[idx] < 0:
                 _write_row(rows, iout, t, idx, f)
             touching[idx] = False
-            return ST_END
+            return EventCode.CONTACT_END
         touching[idx], ramp[idx], clamped[idx] = True, True, False
         delta = pair_state(y, n, pi[idx], pj[idx], rsum[idx], phi, idx)[0]
         peak[idx], t_peak[idx], pen[idx] = 0.0, math.nan, max(0.0, delta)
@@ -202,28 +200,28 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
             f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi, mass, g, omega,
                            zeta, fdead)[0]  # fmt: skip
             _write_row(rows, iout, t, idx, f)
-        return ST_START
+        return EventCode.CONTACT_START
     r = iout[IO_LOG]
     if kind == R_FULL:
         ramp[idx] = not ramp[idx]
-        log[r, 1] = LOG_FULL
+        log[r, 1] = np.int64(EventCode.FULL_DAMPING)  # (an integer code in the float log)
     else:
         clamped[idx] = not clamped[idx]
-        log[r, 1] = LOG_CLAMP_ON if clamped[idx] else LOG_CLAMP_OFF
+        log[r, 1] = np.int64(EventCode.CLAMP_ON if clamped[idx] else EventCode.CLAMP_OFF)
     log[r, 0] = t
     log[r, 2] = idx
     iout[IO_LOG] = r + 1
-    return -1
+    return EventCode.NONE
 
 
 @helper_njit
 def _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
     """Apply the event of row (k, i) at (t, y), remember the row as fresh (its function sits
     on 0 at the restart) and, after a kink handled here, recompute f0 = f(y) in the new
-    region. Returns (status or -1, nfresh)."""
+    region. Returns (status or EventCode.NONE, nfresh)."""
     status = _apply(k, i, t, y, model, pstate, rows, log, iout)
     nfresh = mark(k, i, fresh, nfresh)
-    if status < 0:
+    if status == EventCode.NONE:
         rhs(y, model, pstate, f0)
         iout[IO_NFEV] += 1
     return status, nfresh
@@ -270,23 +268,23 @@ def _rows_needed(model, pstate, nodes):
 def _apply_pending(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
     """At the end of the step redone to end at the pending event of row (k, i): apply it
     (``_apply_here``) if the row is within twice its dead band of the crossing, else drop it.
-    Returns (status or -1, nfresh)."""
+    Returns (status or EventCode.NONE, nfresh)."""
     if row_value(k, i, y, model, pstate) <= 2.0 * row_band(k, i, model[7]):
         return _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0)
-    return np.int64(-1), nfresh
+    return EventCode.NONE, nfresh
 
 
 @helper_njit
 def _limits(attempts, max_steps, nodes, model, pstate, rows, log, iout):
     """ST_STEP_LIMIT after max_steps attempts, ST_BUFFER if one more step (and its events)
-    could overflow the force rows or the kink log, else -1."""
+    could overflow the force rows or the kink log, else EventCode.NONE."""
     if attempts >= max_steps:
         return ST_STEP_LIMIT
     if iout[IO_ROWS] + _rows_needed(model, pstate, nodes) > rows.shape[0] or (
         iout[IO_LOG] + 2 > log.shape[0]
     ):
         return ST_BUFFER
-    return -1
+    return EventCode.NONE
 
 
 @helper_njit
@@ -364,15 +362,15 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
         t_bound = pend_t if pend_k >= 0 else t_stop
         if t >= t_bound:
             if pend_k < 0:
-                return ST_STOP, t, h, attempts, nfresh
+                return EventCode.NONE, t, h, attempts, nfresh
             status, nfresh = _apply_pending(pend_k, pend_i, t, y, model, pstate, rows, log, iout,
                                             fresh, nfresh, f0)  # fmt: skip
             pend_k = np.int64(-1)
-            if status >= 0:
+            if status != EventCode.NONE:
                 return status, t, h, attempts, nfresh
             continue
         status = _limits(attempts, max_steps, nodes, model, pstate, rows, log, iout)
-        if status >= 0:
+        if status != EventCode.NONE:
             return status, t, h, attempts, nfresh
         last = h >= t_bound - t
         hh = t_bound - t if last else h
@@ -406,13 +404,13 @@ def _run(t, h, f0, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, 
             h = hh * factor
             if b >= 0:
                 iout[IO_INDEX] = b
-                return ST_SETTLE, t, h, attempts, nfresh
+                return EventCode.REST, t, h, attempts, nfresh
             continue
         t_e = t + s * hh
         if t_e <= t + 4.0 * EPS * abs(t) or s == 0.0:  # at the restart: apply there
             status, nfresh = _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh,
                                          nfresh, f0)  # fmt: skip
-            if status >= 0:
+            if status != EventCode.NONE:
                 return status, t, h, attempts, nfresh
             continue
         pend_k, pend_i, pend_t = k, i, t_e  # redo the step to end exactly at the event
@@ -425,12 +423,14 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
     """Advance the active set from tio[0] with first step tio[1] until an event or t_stop.
 
     y (6 n + 2 m,) state in/out (m modes); atol (6 n + 2 m,) absolute tolerance per component.
-    model = (mass, radius, g (3,), half (2,), pi, pj, law (P, 5), rsum, e_settle, alive,
+    model = (mass, radius, g (3,), half (2,), pi, pj, law (P, L_CRES + 1), rsum, e_settle, alive,
     omega (m,), zeta (m,), phi (P, m), f_dead (m,)), pstate = (touching, ramp, clamped, peak,
     t_peak, pen): per-pair in/out.
     tab = DOP853 (A, B, E3, E5, D). rows (R, 3) force rows (t, pair, F) and log (L, 3) kinks
     (t, kind, pair) are appended from iout[IO_ROWS], iout[IO_LOG]. On return: tio = [t, next
-    step], iout[IO_STATUS] (ST_*), iout[IO_INDEX] (pair or ball), iout[IO_EDGE], work counts.
+    step], iout[IO_STATUS] (an ``EventCode``: the event returned at, NONE at t_stop; or a
+    private ST_* when it stopped early), iout[IO_INDEX] (pair or ball), iout[IO_EDGE], work
+    counts.
 
     fresh (MAX_FRESH, 2) rows (kind, index) whose events were applied at tio[0], in/out: the
     first iout[IO_FRESH] on entry (the caller passes those of the previous return when it
@@ -453,7 +453,7 @@ def advance(tio, y, t_stop, rtol, atol, max_steps, nodes, model, pstate, tab, pt
                                           nodes, model, pstate, tab, pts, vinv, rows, log, iout,
                                           work, fresh, ncarried)  # fmt: skip
     iout[IO_FRESH] = hand_back(fresh, ncarried, work[7], nfresh, t == tio[0])
-    if status == ST_START:
+    if status == EventCode.CONTACT_START:
         h = min(h, first_contact_step(y, model, iout[IO_INDEX], rtol))
     tio[0] = t
     tio[1] = h

@@ -1,27 +1,30 @@
-"""The compiled active-set integrator of the fast stream solver (issue 7): Python wrapper.
+"""The compiled active-set integrator of the fast stream solver: Python wrapper.
 
 The fast stream solver's driver advances balls in free flight in closed form and hands the
 "active set" (balls in contact plus nearby flying balls, and the pairs to watch) to
 ``ActiveSet.advance``, which integrates them with a compiled DOP853 (8th order, dense output;
-``active_kernel``) until the first structural event or ``t_stop``:
+``kernel``) until the first structural event or ``t_stop``:
 
 * returns at contact START / END (pair index), LEAVE (ball, edge in
-  ``tailbeam.physics.incline.EDGES`` order), SETTLE (ball), or ``t_stop``;
+  ``tailbeam.physics.incline.EDGES`` order), SETTLE (ball: ``EventCode.REST``), or ``t_stop``
+  (``EventCode.NONE``);
 * handles inside (and logs) the kinks of the IMPACT law: penetration = d (when c > 0) and
   clamp on/off; no accepted step straddles a kink;
 * all events are located on the dense output: squared distances, plate gaps and edge
   distances are polynomials of degree <= 14 on a step, certified positive by their
-  Chebyshev coefficients or searched for their first crossing (``cheb_events``), so a grazing
-  approach and retreat inside one step is not missed;
+  Chebyshev coefficients or searched for their first crossing
+  (``tailbeam.solvers.numerics.chebyshev``), so a grazing approach and retreat inside one step
+  is not missed;
 * the rows whose events were applied at the time t a call returns at are carried into the
   next call from t (``fresh_rows``, ``set_fresh``): one found crossing again right at t
-  while back on its side just after is searched again (``active_kernel.advance``);
+  while back on its side just after is searched again (``kernel.advance``);
 * SETTLE is checked at accepted step ends only: a ball whose only touching pair is the plate
-  and whose normal excess energy over the static state (``active_pairs.settle_excess``)
+  and whose normal excess energy over the static state (``pairs.settle_excess``)
   falls below its settle energy;
 * a growing buffer of plate force rows (t, pair, F): every accepted step end, ``nodes_per_step``
   equally spaced interior points of each step (dense output), contact start and end (the end
-  row repeats the time of the last step end); and a log of the kinks (t, kind, pair).
+  row repeats the time of the last step end); and a log of the kinks (t, ``EventCode``,
+  pair).
 
 Optional modal plate (two-way): m mass-normalised modes (omega, zeta), state q, q' after the
 balls; each plate pair has the mode shapes phi (m,) at its contact point (fixed per contact,
@@ -30,7 +33,7 @@ r - (z - w), the ball's force F (+z) loads the modes with -phi F; constant dead 
 (m,) on the modes. The plate gap z - w is still a polynomial on a step, so events are located
 as on the rigid plate. Residual flexibility (optional): each plate pair may have the static
 compliance C (m/N) of the truncated modes at its contact point in series with the contact
-(``compliance``, ``set_compliance``; ``active_pairs.plate_force_with_residual``). Without
+(``compliance``, ``set_compliance``; ``pairs.plate_force_with_residual``). Without
 modes (and C = 0) every result is bit-for-bit the rigid plate's.
 
 Everything in the plate frame (x downhill, z the plate normal, surface z = 0), SI units.
@@ -43,8 +46,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from tailbeam.errors import InputError, WorkLimitError
-from tailbeam.physics.contact_law import law_table
+from tailbeam.physics.contact_law import LAW_COLUMNS, LAW_E, LAW_K, law_table
 from tailbeam.physics.contacts import PLATE, ContactTable, LawOptions
+from tailbeam.results.records import EventCode
 from tailbeam.solvers.numerics.chebyshev import tables as cheb_tables
 from tailbeam.solvers.numerics.dop853 import dop853_tables
 from tailbeam.solvers.stream.active import kernel as ak
@@ -58,20 +62,37 @@ from tailbeam.solvers.stream.active.pairs import (
 )
 
 DEFAULT_NODES = 40  # interior force rows per step: linear interpolation < 1e-5 of the peak
-CARRY_FRESH = True  # False: a restart forgets the events just applied (before issue 7's fix;
-# benchmarks/bench_event_restart.py compares both)
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """Why ``advance`` returned: ``kind`` (``t_stop``, ``contact_start``, ``contact_end``,
-    ``leave``, ``settle``), time ``t`` (s), ``index`` (pair for start/end, ball for
-    leave/settle, -1 otherwise), ``edge`` (leave: 0..3 in EDGES order, else -1)."""
+    """Why ``ActiveSet.advance`` returned.
 
-    kind: str
+    Attributes
+    ----------
+    code : EventCode
+        The event it stopped at: ``CONTACT_START``, ``CONTACT_END``, ``LEAVE``, ``REST`` (a
+        ball's plate contact settled: SETTLE), or ``NONE`` (t_stop reached).
+    t : float
+        Time reached (s).
+    index : int
+        The pair (start, end) or the ball (leave, settle); -1 at t_stop.
+    edge : int
+        Leave: the edge passed, 0..3 in ``tailbeam.physics.incline.EDGES`` order; else -1.
+    """
+
+    code: EventCode
     t: float
     index: int = -1
     edge: int = -1
+
+    @property
+    def kind(self) -> str:
+        """The name of ``code``: its ``EventKind`` (``contact_start``, ``contact_end``,
+        ``leave``), ``settle`` for REST and ``t_stop`` for NONE."""
+        if self.code == EventCode.NONE:
+            return "t_stop"
+        return "settle" if self.code == EventCode.REST else self.code.kind
 
 
 def pair_laws(balls, pairs, plate_material, **options):
@@ -87,20 +108,20 @@ class ActiveSet:
 
     x, v: (n, 3) positions (m) and velocities (m/s), views of the state (in/out); mass (n,) kg;
     radius (n,) m; pairs: (P, 2) ball indices (j = -1: the plate); laws: P ``ImpactLaw``s (or a
-    (P, 5) ``law_table``; kept as (P, 6) with the compliance); gravity (3,) m/s^2 in the plate
-    frame; half_sizes (a/2, b/2) m; settle_energy (n,) J (0 = never); rtol; atol_x (m), atol_v
-    (m/s) (default rtol x 1 mm, rtol x 1 m/s, as the reference); max_steps per ``advance`` call;
-    nodes_per_step: interior force rows per step. Modal plate (optional, all m modes): omega
-    (m,) rad/s, zeta (m,), q, qd (m,) initial modal state (m sqrt(kg), m sqrt(kg)/s; default 0),
-    phi (P, m) mode shapes at each pair's contact point in 1/sqrt(kg) (rows of ball-ball pairs
-    ignored; ``set_phi`` changes a row for a new contact), f_dead (m,) constant modal forces in
-    N/sqrt(kg) (balls resting quasi-statically elsewhere); atol_q, atol_qd (default atol_x / s,
-    atol_v / s with s = max |phi| at construction, so that the deflection under a ball is held
-    to about atol_x; pass them when phi is only set later); compliance (P,) m/N: the residual
-    compliance of each plate pair (default 0; entries of ball-ball pairs ignored).
-    ``q``, ``qd``: views of the modal state (in/out). Per-pair state (in/out): touching, ramp,
-    clamped, peak (N), t_peak (s), pen (m, max penetration). ``alive`` (n,): balls still
-    integrated (False after a leave).
+    (P, LAW_COLUMNS) ``law_table``; kept with the compliance in column L_CRES); gravity (3,)
+    m/s^2 in the plate frame; half_sizes (a/2, b/2) m; settle_energy (n,) J (0 = never); rtol;
+    atol_x (m), atol_v (m/s) (default rtol x 1 mm, rtol x 1 m/s, as the reference); max_steps
+    per ``advance`` call; nodes_per_step: interior force rows per step. Modal plate (optional,
+    all m modes): omega (m,) rad/s, zeta (m,), q, qd (m,) initial modal state (m sqrt(kg), m
+    sqrt(kg)/s; default 0), phi (P, m) mode shapes at each pair's contact point in 1/sqrt(kg)
+    (rows of ball-ball pairs ignored; ``set_phi`` changes a row for a new contact), f_dead (m,)
+    constant modal forces in N/sqrt(kg) (balls resting quasi-statically elsewhere); atol_q,
+    atol_qd (default atol_x / s, atol_v / s with s = max |phi| at construction, so that the
+    deflection under a ball is held to about atol_x; pass them when phi is only set later);
+    compliance (P,) m/N: the residual compliance of each plate pair (default 0; entries of
+    ball-ball pairs ignored). ``q``, ``qd``: views of the modal state (in/out). Per-pair state
+    (in/out): touching, ramp, clamped, peak (N), t_peak (s), pen (m, max penetration). ``alive``
+    (n,): balls still integrated (False after a leave).
 
     For the driver: pairs overlapping at construction start touching (``open_overlapping``,
     region from the state, accumulators reset): overwrite the per-pair arrays to carry a
@@ -209,7 +230,7 @@ class ActiveSet:
         if not self.touching[p]:
             return 0.0
         delta, _ = self.penetration(p)
-        k, e, cres = self.law[p, 0], self.law[p, 1], self.law[p, L_CRES]
+        k, e, cres = self.law[p, LAW_K], self.law[p, LAW_E], self.law[p, L_CRES]
         return float(plate_contact_energy(delta, k, e, cres if self.pj[p] < 0 else 0.0))
 
     def modal_energy(self) -> float:
@@ -227,14 +248,14 @@ class ActiveSet:
 
     def open_overlapping(self):
         """Pairs overlapping now start touching, in their region (a ball placed at its static
-        penetration), as ``stream_reference``'s ``touch``."""
+        penetration), as ``tailbeam.solvers.stream.reference``'s ``touch``."""
         for p in range(len(self.pi)):
             if self.touching[p] or not self.alive[self.pi[p]]:
                 continue
             delta, rate = self.penetration(p)
             if delta <= 0.0:
                 continue
-            k, e, c, d, clamp = self.law[p, :5]
+            k, e, c, d, clamp = self.law[p, :LAW_COLUMNS]  # (LAW_K ... LAW_CLAMP)
             self.touching[p] = True
             self.ramp[p] = delta < d or c <= 0.0
             ind = clamp_indicator(delta, rate, k, e, c, d, self.ramp[p])
@@ -251,9 +272,9 @@ class ActiveSet:
     # --- the events just applied (carried to the next call at the same time) ----------------
     def fresh_rows(self) -> tuple[float, list]:
         """(t s, [(kind, index)]): the rows whose events were applied at the time t the last
-        ``advance`` returned at (kind ``active_pairs.R_CONTACT``, ``R_FULL``, ``R_CLAMP``:
+        ``advance`` returned at (kind ``pairs.R_CONTACT``, ``R_FULL``, ``R_CLAMP``:
         index a pair; ``R_EDGE``: index 4 ball + edge). The next call from t does not find
-        them again at t (``active_kernel.advance``)."""
+        them again at t (``kernel.advance``)."""
         n = int(self.iout[ak.IO_FRESH])
         return self.t_fresh, [(int(k), int(i)) for k, i in self.fresh[:n]]
 
@@ -280,9 +301,9 @@ class ActiveSet:
         1e-5 s). Grows the force-row and log buffers as needed. A call that starts at the
         time the previous one returned at carries the rows whose events were applied then
         (``fresh_rows``): one whose crossing sits on 0 there is not applied again at once
-        (``active_kernel.advance``)."""
+        (``kernel.advance``)."""
         tio = np.array([float(t0), float(h or self.h or 1e-5)])
-        if tio[0] != self.t_fresh or not CARRY_FRESH:
+        if tio[0] != self.t_fresh:
             self.iout[ak.IO_FRESH] = 0
         while True:
             self.iout[ak.IO_STATUS] = -1
@@ -304,10 +325,10 @@ class ActiveSet:
             )
         if status == ak.ST_STEP_TINY:
             raise RuntimeError(f"active set: step size underflow at t = {tio[0]:.17g} s")
-        kind = ak.STATUS_NAMES[status]
-        index = int(self.iout[ak.IO_INDEX]) if status != ak.ST_STOP else -1
-        edge = int(self.iout[ak.IO_EDGE]) if status == ak.ST_LEAVE else -1
-        return Outcome(kind, float(tio[0]), index, edge)
+        code = EventCode(status)
+        index = int(self.iout[ak.IO_INDEX]) if code != EventCode.NONE else -1
+        edge = int(self.iout[ak.IO_EDGE]) if code == EventCode.LEAVE else -1
+        return Outcome(code, float(tio[0]), index, edge)
 
     def _grow(self):
         if self.iout[ak.IO_ROWS] + 4 * (self.nodes + 1) * len(self.pi) > self.rows.shape[0] // 2:
@@ -325,9 +346,9 @@ class ActiveSet:
         return self.rows[: self.iout[ak.IO_ROWS]]
 
     def kink_log(self) -> list:
-        """(t, kind name, pair) of the kinks handled inside so far."""
+        """(t s, ``EventKind``, pair) of the kinks handled inside so far."""
         out = self.log[: self.iout[ak.IO_LOG]]
-        return [(float(t), ak.LOG_NAMES[int(k)], int(p)) for t, k, p in out]
+        return [(float(t), EventCode(int(k)).kind, int(p)) for t, k, p in out]
 
     def clear_outputs(self):
         """Forget the force rows and the kink log (the caller has consumed them)."""
@@ -337,20 +358,20 @@ class ActiveSet:
     @property
     def stats(self) -> dict:
         """Accepted steps, attempted steps, right-hand-side evaluations and events found
-        again at the instant they were applied (searched again: ``active_kernel.advance``)."""
+        again at the instant they were applied (searched again: ``kernel.advance``)."""
         return {"steps": int(self.iout[ak.IO_STEPS]), "attempts": int(self.iout[ak.IO_ATTEMPTS]),
                 "nfev": int(self.iout[ak.IO_NFEV]),
                 "found_again": int(self.iout[ak.IO_AGAIN])}  # fmt: skip
 
 
 def _with_compliance(laws, pj, compliance) -> np.ndarray:
-    """(P, 6) law table: a (P, 5) ``law_table`` and the residual compliance of each plate
-    pair (m/N; 0 for ball-ball pairs and when ``compliance`` is None)."""
+    """(P, L_CRES + 1) law table: a (P, LAW_COLUMNS) ``law_table`` and the residual
+    compliance of each plate pair (m/N; 0 for ball-ball pairs and when ``compliance`` is None)."""
     laws = np.asarray(laws, dtype=float)
-    laws = laws if laws.ndim == 2 else laws.reshape(-1, 5)
+    laws = laws if laws.ndim == 2 else laws.reshape(-1, LAW_COLUMNS)
     if laws.shape[0] != len(pj):
         raise InputError("laws", f"one law per pair: got {len(laws)} laws for {len(pj)} pairs")
-    laws = laws[:, :5]
+    laws = laws[:, :LAW_COLUMNS]
     cres = np.zeros(len(pj)) if compliance is None else np.asarray(compliance, dtype=float)
     if cres.shape != (len(pj),) or not np.all(np.isfinite(cres)) or np.any(cres < 0.0):
         raise InputError("compliance", f"must be {len(pj)} finite values >= 0 m/N (one per pair)")

@@ -18,7 +18,18 @@ PENDING, FLY, SLIDE, ACTIVE, GONE = range(5)
 
 
 class Balls:
-    """Per-ball arrays of a stream (n balls, in release order)."""
+    """Per-ball arrays of a stream (n balls, in release order).
+
+    Parameters
+    ----------
+    particles : list of Particle
+        The stream's particles (name, mass kg, radius m, t_release s, position m, velocity
+        m/s in the plate frame).
+    incline : InclinedPlate
+        The plate (half sizes m) and gravity (m/s^2, plate frame).
+    contacts : ContactTable
+        The particles' contact laws.
+    """
 
     def __init__(self, particles, incline, contacts):
         self.particles = list(particles)
@@ -75,6 +86,15 @@ class Balls:
     def closed_form(self) -> np.ndarray:
         """Indices of the balls moving in closed form (FLY or SLIDE)."""
         return np.flatnonzero((self.status == FLY) | (self.status == SLIDE))
+
+    def resting(self, t: float):
+        """(xy (p, 2) m, weights (p,) N) of the balls resting on the plate outside the
+        active set (SLIDE) at time t (s)."""
+        idx = np.flatnonzero((self.status == SLIDE) & ~self.in_set)
+        if not len(idx):
+            return np.empty((0, 2)), np.empty(0)
+        x, _ = self.states(idx, t)
+        return x[:, :2], self.mass[idx] * -self.g[2]
 
     def speed_bounds(self, idx, t: float, horizon: float) -> np.ndarray:
         """Bounds (m/s) on the speeds of closed-form balls ``idx`` over [t, t + horizon]."""

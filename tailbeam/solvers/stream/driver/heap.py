@@ -1,14 +1,11 @@
-"""The stream driver's heap: releases, epochs and the predictions of the closed-form balls
-(a mixin of ``tailbeam.solvers.stream.driver.loop._Stream``, which provides ``balls``, ``act``,
-``t``, ``heap``, ``seq``, ``epoch``, ``epoch_end``, ``duration``, ``plate``, ``landing``,
-``w_margin``, ``events``, ``leaves``, ``stats`` and the membership of ``stream_membership``).
+"""The stream driver's heap: releases, epochs and the predictions of the closed-form balls.
 
 Balls that touch nothing move in closed form (``tailbeam.solvers.numerics.flight``) and carry
 predictions in one heap, each tagged with the balls' versions (a prediction whose ball has
-changed its motion since is stale and skipped): a particle's release (postponed by
-RELEASE_RETRY while it would overlap a ball already there), a new epoch (its certified
-candidate pairs, ``tailbeam.solvers.stream.driver.broadphase``), a plate touch, the first touch of
-two balls, an edge crossing. A touch makes its balls join the active set.
+changed its motion since is stale and skipped): a particle's release, a new epoch (its
+certified candidate pairs, ``broadphase``), a plate touch, the first touch of two balls, an
+edge crossing. On the modal plate plate touches are predicted ``w_margin`` above the plate,
+a margin kept above the plate's deflection bound. ``heap_events`` handles what comes due.
 """
 
 import heapq
@@ -16,87 +13,68 @@ import math
 
 import numpy as np
 
-from tailbeam.physics.contact_law import elastic_energy
-from tailbeam.results.records import Event, EventKind, LeaveEvent
-from tailbeam.solvers.stream.driver.balls import ACTIVE, FLY, GONE, SLIDE
+from tailbeam.solvers.stream.driver.balls import FLY
 from tailbeam.solvers.stream.driver.broadphase import candidate_pairs
 
-RELEASE_RETRY = 1e-3  # s: a particle that would overlap a ball at its release waits this long
-# heap event kinds (the order breaks ties at equal times: releases first)
-_RELEASE, _EPOCH, _PLATE, _PAIR, _EDGE = range(5)
+# kinds of heap entries (the order breaks ties at equal times: releases first)
+RELEASE, EPOCH, PLATE_TOUCH, PAIR_TOUCH, EDGE = range(5)
+MIN_EPOCH = 1e-4  # s: the shortest epoch
 
 
-class StreamHeap:
-    """The heap events of the stream driver and the closed-form balls' predictions."""
+class Predictions:
+    """The heap of the closed-form balls' events and the broad phase's epochs.
 
-    def push(self, t, kind, i=-1, j=-1, edge=""):
+    Parameters
+    ----------
+    balls : Balls
+        The stream's balls.
+    clock : Clock
+        The driver's time and counters.
+    plate : StreamPlate or None
+        The modal plate (its deflection bound sets the plate-touch margin), or None.
+    """
+
+    def __init__(self, balls, clock, plate=None):
+        self.balls, self.clock, self.plate = balls, clock, plate
+        self.heap, self.seq = [], 0
+        self.epoch = epoch_length(balls, clock.duration)  # s
+        self.epoch_end = 0.0  # s
+        self.w_margin = 0.0  # m: plate touches are predicted this far above the plate
+
+    def start(self) -> None:
+        """The releases of every particle and the first epoch."""
+        for i, t in enumerate(self.balls.t_release):
+            self.push(float(t), RELEASE, i)
+        self.push(0.0, EPOCH)
+
+    def push(self, t: float, kind: int, i: int = -1, j: int = -1, edge: str = "") -> None:
+        """Entry ``kind`` of balls i (and j) at t (s), tagged with their versions now."""
         vi = self.balls.version[i] if i >= 0 else 0
         vj = self.balls.version[j] if j >= 0 else 0
         self.seq += 1
         heapq.heappush(self.heap, (t, kind, self.seq, i, j, vi, vj, edge))
 
-    def _handle(self, entry):
-        t, kind, _seq, i, j, vi, vj, edge = entry
+    def next_time(self) -> float:
+        """Time (s) of the first entry (inf when empty)."""
+        return self.heap[0][0] if self.heap else math.inf
+
+    def pop(self):
+        """The first entry (t, kind, seq, i, j, vi, vj, edge), or None when it is stale."""
+        entry = heapq.heappop(self.heap)
+        _t, _kind, _seq, i, j, vi, vj, _edge = entry
         b = self.balls
         if (i >= 0 and b.version[i] != vi) or (j >= 0 and b.version[j] != vj):
-            self.stats["stale"] += 1
-            return
-        self.stats["heap_events"] += 1
-        if kind == _RELEASE:
-            self._release(i)
-        elif kind == _EPOCH:
-            self._new_epoch()
-        elif kind == _PLATE and b.status[i] == FLY and not b.in_set[i]:
-            if self.plate is None:
-                self._join([i], t, (i, -1))
-            else:  # near the vibrating plate: the integrator finds the real start
-                self._absorb(i)
-                self.landing.add(i)
-                self._make_core(i)
-                self._refresh_set()
-        elif kind == _PAIR and not (b.in_set[i] and b.in_set[j]):
-            if b.status[i] in (FLY, SLIDE) and b.status[j] in (FLY, SLIDE):
-                self._join([i, j], t, (min(i, j), max(i, j)))
-        elif kind == _EDGE and b.status[i] in (FLY, SLIDE) and not b.in_set[i]:
-            self._leave(i, edge, t)
+            self.clock.stats["stale"] += 1
+            return None
+        return entry
 
-    # --- heap events --------------------------------------------------------------------------
-    def _release(self, i: int):
-        b = self.balls
-        if self._overlaps_at_release(i):
-            self.stats["postponed_releases"] += b.t_release[i] == b.particles[i].t_release
-            b.t_release[i] = self.t + RELEASE_RETRY
-            self.push(b.t_release[i], _RELEASE, i)
-            return
-        b.set_motion(i, FLY, self.t, b.x0[i].copy(), b.v0[i].copy())
-        x, v = b.state(i, self.t)
-        on_plate = float(elastic_energy(b.radius[i] - x[2], b.plate_law(i)))  # released there
-        self.stats["energy_released"] += self._ball_energy(i, x, v) + on_plate
-        self.events.append(Event(self.t, b.names[i], EventKind.RELEASE, ""))
-        self._predict(i)
-        if self.act.members:
-            self._refresh_set()
-
-    def _overlaps_at_release(self, i: int) -> bool:
-        """Does particle i, released now, overlap a ball already there (the generator
-        only knows the free flights of earlier particles, not their rebounds)?"""
-        b = self.balls
-        others = b.closed_form()
-        centres = b.states(others, self.t)[0] if len(others) else np.empty((0, 3))
-        core = [k for k in self.act.members if b.status[k] == ACTIVE]
-        if core:
-            centres = np.vstack([centres, self.act.positions(core)])
-            others = np.concatenate([others, np.array(core, dtype=np.int64)])
-        reach = b.radius[others] + b.radius[i]
-        return bool(np.any(np.sum((centres - b.x0[i]) ** 2, axis=1) < reach**2))
-
-    def _new_epoch(self):
+    def new_epoch(self) -> None:
         """Certified candidate pairs of the closed-form balls over the next epoch."""
-        b, t = self.balls, self.t
-        self.stats["epochs"] += 1
-        self.epoch_end = min(t + self.epoch, self.duration)
-        if self.epoch_end < self.duration:
-            self.push(self.epoch_end, _EPOCH)
+        b, t = self.balls, self.clock.t
+        self.clock.stats["epochs"] += 1
+        self.epoch_end = min(t + self.epoch, self.clock.duration)
+        if self.epoch_end < self.clock.duration:
+            self.push(self.epoch_end, EPOCH)
         idx = b.closed_form()
         if len(idx) < 2:
             return
@@ -108,17 +86,17 @@ class StreamHeap:
             if not (b.in_set[i] and b.in_set[j]):
                 self._predict_pair(i, j, horizon)
 
-    def _predict(self, i: int):
+    def predict(self, i: int) -> None:
         """Own events of closed-form ball i, and its touches with the other closed-form
         balls within the epoch."""
-        for t_ev, what, edge in self.balls.own_events(i, self.t, self.w_margin):
-            self.push(t_ev, _PLATE if what == "plate" else _EDGE, i, edge=edge)
+        for t_ev, what, edge in self.balls.own_events(i, self.clock.t, self.w_margin):
+            self.push(t_ev, PLATE_TOUCH if what == "plate" else EDGE, i, edge=edge)
         self._predict_pairs(i)
 
-    def _predict_pairs(self, i: int):
+    def _predict_pairs(self, i: int) -> None:
         """Touches of closed-form ball i with the others within the epoch (not the pairs
         the active set watches)."""
-        b, t = self.balls, self.t
+        b, t = self.balls, self.clock.t
         horizon = self.epoch_end - t
         others = b.closed_form()
         others = others[(others != i) & ~(b.in_set[others] & b.in_set[i])]
@@ -133,26 +111,32 @@ class StreamHeap:
         for j in others[np.sum((xo - xi) ** 2, axis=1) <= reach**2]:
             self._predict_pair(i, int(j), horizon)
 
-    def _predict_pair(self, i: int, j: int, horizon: float):
-        t_ev = self.balls.pair_event(i, j, self.t, horizon)
+    def _predict_pair(self, i: int, j: int, horizon: float) -> None:
+        t_ev = self.balls.pair_event(i, j, self.clock.t, horizon)
         if math.isfinite(t_ev):
-            self.push(t_ev, _PAIR, min(i, j), max(i, j))
+            self.push(t_ev, PAIR_TOUCH, min(i, j), max(i, j))
 
-    def _join(self, ids, t: float, key):
-        """Closed-form balls ``ids`` start the contact ``key`` at time t."""
-        for i in ids:
-            if not self.balls.in_set[i]:
-                self._absorb(i)
-        self.act.start_contact(key)
-        self._on_start(key)
-        self._refresh_set()
-
-    def _leave(self, i: int, edge: str, t: float):
+    def check_margin(self) -> None:
+        """Modal plate: keep the plate-touch predictions above the plate's deflection bound;
+        when it has grown past the margin, double the margin and predict again."""
+        if self.plate is None:
+            return
+        bound = self.plate.deflection_bound()
+        if bound <= self.w_margin:
+            return
+        self.w_margin = max(2.0 * bound, 1e-9)
+        self.clock.count("margin_updates")
         b = self.balls
-        self.stats["energy_left"] += self._ball_energy(i, *b.state(i, t)) + self._elastic(i)
-        if b.status[i] == SLIDE:
-            self._dead_load(i, t)
-        b.status[i] = GONE
-        b.version[i] += 1
-        self.leaves.append(LeaveEvent(b.names[i], t, edge))
-        self.events.append(Event(t, b.names[i], EventKind.LEAVE, edge))
+        for i in np.flatnonzero((b.status == FLY) & ~b.in_set):
+            for t_ev, what, _edge in b.own_events(int(i), self.clock.t, self.w_margin):
+                if what == "plate":
+                    self.push(t_ev, PLATE_TOUCH, int(i))
+
+
+def epoch_length(balls, duration: float) -> float:
+    """Epochs (s) short enough that balls move about their radius in one: O(1) candidate
+    pairs per ball."""
+    if not len(balls.names):
+        return duration
+    speed = np.linalg.norm(balls.v0, axis=1).max() + 1.0
+    return float(min(duration, max(MIN_EPOCH, 0.5 * balls.radius.min() / speed)))

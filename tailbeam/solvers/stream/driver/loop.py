@@ -1,36 +1,31 @@
-"""The fast stream solver: many balls on the rigid inclined plate, cost growing with impacts.
+"""The fast stream solver: many balls on an inclined plate, cost growing with impacts.
 
-Event-driven. Balls that touch nothing move in closed form (``tailbeam.solvers.numerics.flight``) and
-carry predictions in one heap: release, plate touch, edge crossing and, among the candidate
-pairs of the current epoch (``tailbeam.solvers.stream.driver.broadphase``, certified over the epoch), the
-first touch of two balls. The balls in contact, and every ball that could reach one of them
-within the set's horizon, form the ACTIVE SET, integrated by the compiled kernel
-(``tailbeam.solvers.stream.active.set``: DOP853, every kink an event) up to the next heap event, its
-horizon or its own next event. Work is therefore spent per contact and per event, never per
-ball per step; memory holds the records, not the trajectories.
+Event-driven. Balls that touch nothing move in closed form (``tailbeam.solvers.numerics.flight``)
+and carry predictions in one heap (``heap``): release, plate touch, edge crossing and, among
+the candidate pairs of the current epoch (``broadphase``, certified over the epoch), the first
+touch of two balls (``heap_events`` handles them). The balls in contact, and every ball that
+could reach one of them within the set's horizon, form the ACTIVE SET (``membership``),
+integrated by the compiled kernel (``tailbeam.solvers.stream.active``: DOP853, every kink an
+event) up to the next heap event, its horizon or its own next event (``set_events``). Work is
+therefore spent per contact and per event, never per ball per step; memory holds the
+records, not the trajectories.
 
 Persistent contact at bounded cost: a ball whose plate contact has settled (the kernel's
-SETTLE: its normal excess energy below 1/2 m rest_speed^2) or that rebounds slower than
-``rest_speed`` becomes a SLIDER: its height is held at the static penetration and it slides
-frictionlessly downhill in closed form (its normal oscillation, below the rest energy, is
-dropped: the energy removed is counted in ``stats["rest_energy_removed"]``). A slider that
-something approaches joins the active set again, at its static state (an equilibrium of the
-full model, so nothing jumps).
+SETTLE, ``EventCode.REST``: its normal excess energy below 1/2 m rest_speed^2) or that
+rebounds slower than ``rest_speed`` becomes a SLIDER: its height is held at the static
+penetration and it slides frictionlessly downhill in closed form (its normal oscillation,
+below the rest energy, is dropped: the energy removed is counted in
+``stats["rest_energy_removed"]``, ``energy``). A slider that something approaches joins the
+active set again, at its static state (an equilibrium of the full model, so nothing jumps).
 
-Contacts are recorded as ``Impact`` (one per ball per contact; ``end`` is
-``separated``, ``rest``, ``left`` or ``duration``); the plate's contact forces are kept as
+Contacts are recorded as ``Impact`` (one per ball per contact; ``end`` an ``End``:
+separated, rest, left or duration; ``records``); the plate's contact forces are kept as
 piecewise-linear histories at their contact points and sliders as dead loads, for the modal
-plate's sensors.
-
-Modules: the heap of releases, epochs and closed-form predictions (``stream_heap``), the
-stepping of the active set and its events (``stream_set_events``), its membership
-(``stream_membership``), the records, loads and energy ledger (``stream_records``); this
-module holds the driver loop, its work bounds and the entry points.
+plate's sensors (``loads``). The run's time and counters are its ``clock``; this module wires
+the parts into the loop and holds its work bounds and the entry point.
 """
 
 import contextlib
-import heapq
-import math
 import time as _time
 from dataclasses import dataclass, field, replace
 
@@ -41,32 +36,59 @@ from tailbeam.physics.contact_law import HERTZ_EXPONENT
 from tailbeam.physics.contacts import contact_table
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import note, quiet, task
+from tailbeam.solvers.stream.active.members import ActiveMembers
 from tailbeam.solvers.stream.driver.balls import SLIDE, Balls, LawOptions
-from tailbeam.solvers.stream.driver.heap import _EPOCH, _RELEASE, StreamHeap
-from tailbeam.solvers.stream.driver.membership import StreamMembership
-from tailbeam.solvers.stream.driver.records import StreamRecords
-from tailbeam.solvers.stream.driver.set_events import StreamSetEvents
+from tailbeam.solvers.stream.driver.clock import Clock
+from tailbeam.solvers.stream.driver.energy import EnergyLedger
+from tailbeam.solvers.stream.driver.heap import Predictions
+from tailbeam.solvers.stream.driver.heap_events import HeapEvents
+from tailbeam.solvers.stream.driver.loads import PlateLoads
+from tailbeam.solvers.stream.driver.membership import Membership
+from tailbeam.solvers.stream.driver.records import ContactRecords
+from tailbeam.solvers.stream.driver.set_events import SetEvents
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
 DEFAULT_MAX_STEPS = 50_000_000  # kernel steps + events: the work bound
 MAX_PARTICLES = 200_000  # per scene: memory ~40 kB per particle (records, force histories)
 GRAZING_RETRIES = 2  # runs again at rtol / 10, / 100 after a stall at one instant: a last
-# safety net (the kernel no longer finds an event again at the instant it applied it)
+# safety net (the kernel does not find an event again at the instant it applied it)
 WORK_CHECK_EVERY = 16  # loop rounds between two checks of the work bound
 STUCK_LIMIT = 5_000  # loop rounds without time moving before the run is stopped
 
 
 @dataclass
 class StreamRun:
-    """What the stream solver found (``tailbeam.solvers.stream.stream_result`` presents it)."""
+    """What the stream solver found (``tailbeam.solvers.stream.stream_result`` presents it).
 
-    particles: list  # as released (a release onto a rebounding ball is postponed)
+    Attributes
+    ----------
+    particles : list of Particle
+        The particles as released (a release onto a rebounding ball is postponed).
+    contacts : list of Impact
+        One record per ball per contact, in order of start and ball; ``end`` an ``End``.
+    leaves : list of LeaveEvent
+        The balls that left the plate over an edge.
+    events : list of Event
+        Every event in time order.
+    loads : list of tuple
+        (x m, y m, t_nodes (k,) s, forces (k,) N): plate contact force histories.
+    dead_loads : list of tuple
+        (x m, y m, t_from s, t_to s, force N): the sliders' weight on the plate.
+    status : int
+        0: the end of the simulated time was reached.
+    message : str
+        What ``status`` means.
+    stats : dict
+        Work counters and the energy ledger (J).
+    """
+
+    particles: list
     contacts: list
     leaves: list
     events: list
-    loads: list  # (x, y, t_nodes, forces): plate contact force histories (m, s, N)
-    dead_loads: list  # (x, y, t_from, t_to, force): sliders' weight on the plate
+    loads: list
+    dead_loads: list
     status: int
     message: str
     stats: dict = field(default_factory=dict)
@@ -88,13 +110,39 @@ def solve_stream(
     plate=None,
     contacts=None,
 ) -> StreamRun:
-    """Simulate ``particles`` (``tailbeam.streams.generator.Particle``: released at their
-    t_release with their position and velocity, plate frame) on ``incline`` for ``duration``
-    s. IMPACT parameters shared by every pair (stiffness from Hertz for each pair); rtol: the
-    kernel's relative tolerance; rest_speed (m/s): see the module docstring; max_work: bound
-    on kernel steps plus events (WorkLimitError beyond); plate: a ``StreamPlate`` (the modal
-    plate, two-way) or None (the rigid plate); contacts: the particles' ``ContactTable``
-    (its settings then replace the IMPACT parameters given here)."""
+    """Simulate a stream of particles on an inclined plate.
+
+    Parameters
+    ----------
+    particles : list of Particle
+        ``tailbeam.streams.generator.Particle``: released at their t_release (s) with their
+        position (m) and velocity (m/s), plate frame.
+    incline : InclinedPlate
+        The plate and gravity.
+    duration : float
+        Simulated time (s).
+    damping, penetration, clamp, exponent : float, float, bool, float
+        IMPACT parameters shared by every pair: damping c (N s/m), full-damping penetration
+        d (m), the clamp, Hertz exponent (stiffness from Hertz for each pair).
+    rtol : float
+        The active set's relative tolerance, in [1e-14, 1e-4].
+    rest_speed : float
+        Speed (m/s) below which a plate contact ends at rest (see the module docstring).
+    max_work : int
+        Bound on kernel steps plus events (``WorkLimitError`` beyond).
+    progress : bool or callable
+        Show a progress bar, or a callable told the simulated time reached (s).
+    plate : StreamPlate, optional
+        The two-way modal plate (None: the rigid plate).
+    contacts : ContactTable or LawOptions, optional
+        The particles' contact laws (their settings then replace the IMPACT parameters).
+
+    Returns
+    -------
+    StreamRun
+        The records, loads and counters (``stats["rtol"]``: the tolerance used; it is
+        tightened when contacts stall at one instant).
+    """
     duration = require_positive("duration", duration)
     if not 1e-14 <= rtol <= 1e-4:
         raise InputError("rtol", f"must lie in [1e-14, 1e-4], got {rtol!r}")
@@ -134,7 +182,7 @@ def _run(sim, duration, progress) -> "StreamRun":
 class _Stuck(WorkLimitError):
     """Contacts start and end again at one instant: no progress (a grazing contact). The
     active set carries the events it applied at an instant into its next call from there
-    (``active_kernel.advance``), the cause seen before; the retry stays as a safety net."""
+    (``tailbeam.solvers.stream.active.kernel.advance``); the retry is a safety net."""
 
 
 class _CallbackBar:
@@ -148,92 +196,83 @@ class _CallbackBar:
         self.report(self.ms / 1e3)
 
 
-class _Stream(StreamHeap, StreamSetEvents, StreamMembership, StreamRecords):
-    """The event loop; see the module docstring."""
+class _Stream:
+    """The event loop of one run, wiring the driver's parts (see the module docstring).
+
+    Parameters
+    ----------
+    particles : list of Particle
+        The stream's particles.
+    incline : InclinedPlate
+        The plate and gravity.
+    duration : float
+        Simulated time (s).
+    contacts : ContactTable
+        The particles' contact laws.
+    rtol : float
+        The active set's relative tolerance.
+    rest_speed : float
+        Speed (m/s) below which a plate contact ends at rest.
+    max_events : int
+        Bound on kernel steps plus events (WorkLimitError beyond).
+    plate : StreamPlate or None
+        The two-way modal plate, or None (the rigid plate).
+    """
 
     def __init__(self, particles, incline, duration, contacts, rtol, rest_speed, max_events, plate):
-        from tailbeam.solvers.stream.active.members import ActiveMembers
+        self.clock = clock = Clock(duration)
+        self.balls = balls = Balls(particles, incline, contacts)
+        self.plate, self.max_events, self.rounds = plate, max_events, 0
 
-        self.balls = Balls(particles, incline, contacts)
-        self.incline, self.duration = incline, duration
-        self.rest_speed, self.max_events = rest_speed, max_events
-        self.plate = plate
-        self.act = ActiveMembers(
-            self.balls, rtol, self._settle_energy, plate, self._resting_outside
-        )
-        self.landing = set()  # modal plate: balls within the deflection bound, touching nothing
-        self.hold = {}  # ball -> time of a contact end: core until time moves on
-        self.grazing = {}  # ball -> (time of its last plate contact end, how many then)
-        self.w_margin = 0.0  # modal plate: plate touches are predicted this far above it
-        self.heap, self.seq, self.t, self.rounds = [], 0, 0.0, 0
-        self.epoch_end, self.set_end = 0.0, 0.0
-        self.core = set()
-        self.contacts, self.leaves, self.events = [], [], []
-        self.open = {}  # (i, j) -> [Impact(s)] of the contacts in progress
-        self.limit = {}  # i -> time at which ball i's plate contact is declared at rest
-        self.loads, self.dead_loads = [], []
-        self.stats = dict.fromkeys(
-            (
-                "heap_events",
-                "stale",
-                "set_events",
-                "set_calls",
-                "epochs",
-                "late_starts",
-                "postponed_releases",
-            ),
-            0,
-        )
-        # the energy ledger (J): released = left + at the end + removed at rest + dissipated
-        for key in ("rest_energy_removed", "energy_released", "energy_left", "energy_final"):
-            self.stats[key] = 0.0
-        self.epoch = self._epoch_length()
+        def settle_energy(i: int) -> float:
+            return 0.5 * balls.mass[i] * rest_speed**2
 
-    # --- setup ----------------------------------------------------------------------------
-    def _epoch_length(self) -> float:
-        """Epochs short enough that balls move ~ their radius: O(1) candidates per ball."""
-        b = self.balls
-        if not len(b.names):
-            return self.duration
-        speed = np.linalg.norm(b.v0, axis=1).max() + 1.0
-        return float(min(self.duration, max(1e-4, 0.5 * b.radius.min() / speed)))
+        self.act = act = ActiveMembers(balls, rtol, settle_energy, plate,
+                                       lambda: balls.resting(clock.t))  # fmt: skip
+        self.ledger = EnergyLedger(balls, act, clock.stats)
+        self.records = ContactRecords(balls, act, clock, rest_speed)
+        self.loads = PlateLoads(balls, act.forces)
+        self.heap = Predictions(balls, clock, plate)
+        parts = (balls, act, clock, self.heap)
+        self.membership = Membership(*parts, self.records, self.loads, self.ledger, plate)
+        shared = (*parts, self.membership, self.records, self.loads, self.ledger)
+        self.set_events = SetEvents(*shared, rest_speed)
+        self.heap_events = HeapEvents(*shared, plate)
 
-    def _settle_energy(self, i: int) -> float:
-        return 0.5 * self.balls.mass[i] * self.rest_speed**2
-
-    # --- the loop ---------------------------------------------------------------------------
     def run(self, bar) -> StreamRun:
+        """Run to the end; ``bar.update(ms)`` is told the simulated time reached."""
         wall = _time.perf_counter()
-        for i, t in enumerate(self.balls.t_release):
-            self.push(float(t), _RELEASE, i)
-        self.push(0.0, _EPOCH)
+        clock, act, heap = self.clock, self.act, self.heap
+        heap.start()
         shown, stuck, t_last = 0.0, 0, -1.0
         while True:
             self._check_work()
-            stuck = stuck + 1 if self.t == t_last else 0
-            t_last = self.t
+            stuck = stuck + 1 if clock.t == t_last else 0
+            t_last = clock.t
             if stuck > STUCK_LIMIT:
                 raise _Stuck(self._stuck_message())
-            t_next = self.heap[0][0] if self.heap else math.inf
-            target = min(t_next, self.duration)
-            if self.act.members and self._advance_set(target):
+            t_next = heap.next_time()
+            target = min(t_next, clock.duration)
+            if act.members and self.set_events.advance(target):
                 continue
-            self.t = self.act.now = target
-            if self.t - shown > 1e-3:
-                bar.update(1e3 * (self.t - shown))
-                shown = self.t
-            if t_next >= self.duration:
+            clock.t = act.now = target
+            if clock.t - shown > 1e-3:
+                bar.update(1e3 * (clock.t - shown))
+                shown = clock.t
+            if t_next >= clock.duration:
                 break
-            self._handle(heapq.heappop(self.heap))
-        bar.update(1e3 * (self.duration - shown))
+            entry = heap.pop()
+            if entry is not None:
+                self.heap_events.handle(entry)
+        bar.update(1e3 * (clock.duration - shown))
         return self._finish(_time.perf_counter() - wall)
 
     def _stuck_message(self) -> str:
         """The loop has not moved time for STUCK_LIMIT rounds: what is going on."""
-        names = [self.balls.names[i] for i in sorted(self.core)][:4]
+        names = [self.balls.names[i] for i in sorted(self.membership.core)][:4]
         return (
-            f"rtol: the stream solver makes no progress at t = {self.t:.9g} s: contacts of "
-            f"{', '.join(names)} start and end again at one instant (a grazing contact the "
+            f"rtol: the stream solver makes no progress at t = {self.clock.t:.9g} s: contacts "
+            f"of {', '.join(names)} start and end again at one instant (a grazing contact the "
             "event restart cannot resolve, a known limitation); a tighter rtol resolves it"
         )
 
@@ -241,11 +280,13 @@ class _Stream(StreamHeap, StreamSetEvents, StreamMembership, StreamRecords):
         self.rounds += 1
         if self.rounds % WORK_CHECK_EVERY:
             return
-        n = self.stats["heap_events"] + self.stats["set_events"] + self.act.steps()
+        stats = self.clock.stats
+        n = stats["heap_events"] + stats["set_events"] + self.act.steps()
         if n > self.max_events:
             raise WorkLimitError(
-                f"max_steps: more than {self.max_events} steps and events by t = {self.t:.6g}"
-                " s; raise max_steps, shorten duration or lower the stream rates"
+                f"max_steps: more than {self.max_events} steps and events by "
+                f"t = {self.clock.t:.6g} s; raise max_steps, shorten duration or lower the "
+                "stream rates"
             )
 
     def _released(self) -> list:
@@ -257,30 +298,28 @@ class _Stream(StreamHeap, StreamSetEvents, StreamMembership, StreamRecords):
         ]
 
     def _finish(self, wall: float) -> StreamRun:
-        b = self.balls
-        self.t = self.duration
-        self.stats["energy_final"] = self._final_energy()
+        """The end of the simulated time: final energies, the records and loads of what is
+        still in progress, the counters."""
+        b, act, stats, loads = self.balls, self.act, self.clock.stats, self.loads
+        duration = self.clock.t = self.clock.duration
+        self.ledger.final(duration)
         if self.plate is not None:
-            self.plate.propagate(self.duration)
+            self.plate.propagate(duration)
             # the tails of contacts still in progress are the plate's too (contact_tail)
-            self.stats["energy_plate_final"] = self.plate.energy() + self.act.tail_energy()
+            stats["energy_plate_final"] = self.plate.energy() + act.tail_energy()
             if self.plate.tail is not None:
-                self.stats["tail_energy_dropped"] = self.act.tail_energy_dropped
-        for key in list(self.open):
-            recs = self.open.pop(key)
-            peak, t_peak, pen = self.act.accumulators(key)
-            for rec in recs:
-                rec.peak_force, rec.t_peak, rec.max_penetration = peak, t_peak, pen
-        for i in self.act.members:
-            self._flush_nodes(i)
+                stats["tail_energy_dropped"] = act.tail_energy_dropped
+        self.records.finish()
+        for i in act.members:
+            loads.flush(i)
         for i in np.flatnonzero(b.status == SLIDE):
             if not b.in_set[i]:
-                self._dead_load(int(i), self.duration)
-        self.contacts.sort(key=lambda r: (r.t_start, r.ball))
-        self.stats.update(self.act.stats())
-        self.stats["wall_s"] = wall
-        self.stats["contacts"] = len(self.contacts)
+                loads.dead_load(int(i), duration)
+        stats.update(act.stats())
+        stats["wall_s"] = wall
+        stats["contacts"] = len(self.records.contacts)
+        rec = self.records
         return StreamRun(
-            self._released(), self.contacts, self.leaves, self.events, self.loads,
-            self.dead_loads, 0, "reached the end of the simulated time", self.stats,
+            self._released(), rec.contacts, rec.leaves, rec.events, loads.loads,
+            loads.dead_loads, 0, "reached the end of the simulated time", stats,
         )  # fmt: skip

@@ -1,101 +1,112 @@
-"""The stream driver's stepping of the active set and what the set reports (a mixin of
-``tailbeam.solvers.stream.driver.loop._Stream``, which provides ``balls``, ``act``, ``t``,
-``set_end``, ``open``, ``hold``, ``grazing``, ``landing``, ``rest_speed``, ``events``,
-``leaves``, ``stats``, the records of ``stream_records`` and the membership of
-``stream_membership``).
+"""Advancing the active set and handling what it reports.
 
 The active set (``tailbeam.solvers.stream.active.members``) integrates its members up to a
-target time, its horizon or its own next event: a contact start or end, a plate contact
-settling, a ball leaving over an edge, with the kinks it passed (logged as events). A plate
-contact that ends slower than ``rest_speed`` (or that ends and starts again at one instant,
-grazing) leaves the ball at rest on the plate.
+target time, its horizon or its own next event (an ``EventCode``): a contact start or end,
+a plate contact settling (REST), a ball leaving over an edge; the kinks it passed are logged
+as events. A plate contact that ends slower than ``rest_speed`` (or that ends and starts
+again at one instant, grazing) leaves the ball at rest on the plate.
 """
 
-from tailbeam.results.records import PLATE, Event, EventKind, LeaveEvent
-from tailbeam.solvers.stream.driver.balls import GONE
+from tailbeam.results.records import PLATE, End, EventCode
 
 
-class StreamSetEvents:
-    """Advancing the active set and handling its events."""
+class SetEvents:
+    """The stepping of the active set and its events.
 
-    def _advance_set(self, target: float) -> bool:
-        """Advance the active set towards ``target``; True if it stopped earlier (an event
-        of its own, or its horizon: the loop then starts over)."""
-        stop = min(target, self.set_end)
-        kind, key, t_new = self.act.advance(self.t, stop)
-        self.stats["set_calls"] += 1
-        self.t = self.act.now = t_new
-        self._check_margin()
+    Parameters
+    ----------
+    balls : Balls
+        The stream's balls.
+    act : ActiveMembers
+        The active set.
+    clock : Clock
+        The driver's time and counters.
+    heap : Predictions
+        The closed-form balls' predictions (their plate-touch margin follows the plate).
+    membership : Membership
+        Core, members and the set's horizon.
+    records : ContactRecords
+        The contacts and events.
+    loads : PlateLoads
+        The plate's loads.
+    ledger : EnergyLedger
+        The energy ledger.
+    rest_speed : float
+        Speed (m/s) below which a plate contact that ends leaves the ball at rest.
+    """
+
+    def __init__(self, balls, act, clock, heap, membership, records, loads, ledger,
+                 rest_speed: float):  # fmt: skip
+        self.balls, self.act, self.clock, self.heap = balls, act, clock, heap
+        self.membership, self.records, self.loads, self.ledger = membership, records, loads, ledger
+        self.rest_speed = rest_speed
+        self.grazing = {}  # ball -> (time s of its last plate contact end, how many then)
+        self.handlers = {
+            EventCode.CONTACT_START: membership.start,
+            EventCode.CONTACT_END: self._on_end,
+            EventCode.REST: membership.settle,
+            EventCode.LEAVE: self._on_leave,
+        }
+
+    def advance(self, target: float) -> bool:
+        """Advance the active set towards ``target`` (s); True if it stopped earlier (an
+        event of its own, or its horizon: the loop then starts over)."""
+        stop = min(target, self.membership.set_end)
+        code, key, t_new = self.act.next_event(self.clock.t, stop)
+        self.clock.stats["set_calls"] += 1
+        self.clock.t = self.act.now = t_new
+        self.heap.check_margin()
         self._log_kinks()
-        if kind is not None:
-            self.stats["set_events"] += 1
-            getattr(self, f"_on_{kind}")(key)
-            self._refresh_set()
+        if code != EventCode.NONE:
+            self.clock.stats["set_events"] += 1
+            self.handlers[code](key)
+            self.membership.refresh()
             return True
         if stop < target:
-            self._refresh_set()
+            self.membership.refresh()
             return True
         return False
 
-    def _log_kinks(self):
-        for t, name, p in self.act.kinks:
-            i, j = self.act.keys[p]
-            partner = PLATE if j < 0 else self.balls.names[j]
-            self.events.append(Event(t, self.balls.names[i], EventKind(name), partner))
+    def _log_kinks(self) -> None:
+        for t, kind, (i, j) in self.act.kinks:
+            self.records.event(t, i, kind, PLATE if j < 0 else self.balls.names[j])
 
-    def _on_start(self, key):
-        self.landing.discard(key[0])
-        self._open(key)
+    def _on_end(self, key) -> None:
+        i, j = key
         for k in key:
             if k >= 0:
-                self._make_core(k)
-
-    def _on_end(self, key):
-        i, j = key
-        for k in key:  # the set keeps its members until time moves on (no rebuild at the end
-            if k >= 0:  # instant: a rebuilt set could find the same contact starting again)
-                self.hold[k] = self.t
-        if key not in self.open:  # a pair the set found overlapping (counted in late_starts)
+                self.membership.hold(k)
+        if not self.records.is_open(key):  # a pair the set found overlapping (late_starts)
             return
         if j >= 0:
-            self._close(key, "separated")
+            self.records.close(key, End.SEPARATED)
             return
         others = [p for p in self.act.touching_pairs(i) if p != key]
         v_out = self.act.state(i)[1][2]
         slow = 0.0 <= v_out < self.rest_speed and self.balls.g[2] < 0.0
         if self._grazing(i):  # ends and starts again at one instant: it rests on the plate
             slow = True
-            self.stats["grazing_rests"] = self.stats.get("grazing_rests", 0) + 1
-        self._close(key, "rest" if slow and not others else "separated")
-        self._flush_nodes(i)
+            self.clock.count("grazing_rests")
+        self.records.close(key, End.REST if slow and not others else End.SEPARATED)
+        self.loads.flush(i)
         if slow and not others:
-            self.stats["rest_energy_removed"] += self.act.make_quiet(i)
+            self.ledger.removed_at_rest(self.act.make_quiet(i))
 
     def _grazing(self, i: int) -> bool:
         """The plate contact of ball i ended at this instant before (it started again at
         once: zero speed relative to the vibrating plate): the second time, True."""
+        t = self.clock.t
         t_prev, count = self.grazing.get(i, (None, 0))
-        count = count + 1 if t_prev == self.t else 1
-        self.grazing[i] = (self.t, count)
+        count = count + 1 if t_prev == t else 1
+        self.grazing[i] = (t, count)
         return count >= 2
 
-    def _on_settle(self, i):
-        self._close((i, -1), "rest")
-        self.stats["rest_energy_removed"] += self.act.make_quiet(i)
-
-    def _on_leave(self, what):
+    def _on_leave(self, what) -> None:
         i, edge = what
-        b = self.balls
-        self.stats["energy_left"] += self._ball_energy(i, *self.act.state(i)) + self._elastic(i)
+        self.ledger.left(i, *self.act.state(i))
         for key in self.act.touching_pairs(i):
-            if key in self.open:
-                self._close(key, "left")
-        self._flush_nodes(i)
-        self.act.remove(i)
-        b.in_set[i] = False
-        b.status[i] = GONE
-        b.version[i] += 1
-        self.core.discard(i)
-        self.landing.discard(i)
-        self.leaves.append(LeaveEvent(b.names[i], self.t, edge))
-        self.events.append(Event(self.t, b.names[i], EventKind.LEAVE, edge))
+            if self.records.is_open(key):
+                self.records.close(key, End.LEFT)
+        self.loads.flush(i)
+        self.membership.leave(i)
+        self.records.leave(i, self.clock.t, edge)
