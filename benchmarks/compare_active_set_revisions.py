@@ -42,7 +42,7 @@ def run_scenes(out_path):
         run = SceneRun(getattr(stream_scenes, scene)(incline), incline, 0.1, sample=5e-4,
                        rtol=1e-10, **options)  # fmt: skip
         s = run.set
-        out[name] = {"y": s.y.copy(), "rows": s.force_rows().copy(), "log": s.kink_log(),
+        out[name] = {"y": s.y.copy(), "rows": s.force_rows().copy(), "log": [(t, str(kind), p) for t, kind, p in s.kink_log()],
                      "stats": s.stats, "contacts": [repr(vars(c)) for c in run.contacts],
                      "energy": np.array(run.energy), "times": np.array(run.times)}  # fmt: skip
     Path(out_path).write_bytes(pickle.dumps(out))

@@ -18,6 +18,7 @@ import pytest
 from tailbeam import CARBON_STEEL, COAL, Ball, ball_ball_law, ball_plate_law
 from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.results.records import EventCode
 from tailbeam.solvers.stream.active.members import ActiveMembers
 from tailbeam.solvers.stream.active.pairs import R_CONTACT
 from tailbeam.solvers.stream.active.set import ActiveSet
@@ -123,8 +124,8 @@ def test_a_start_returns_its_marker_and_a_rebuilt_set_keeps_it():
     act = ActiveMembers(balls, 1e-10, lambda i: 0.0)
     for i in (0, 1):
         act.add(i, particles[i].position, particles[i].velocity, quiet=False)
-    kind, key, t = act.advance(0.0, 1.0)
-    assert (kind, key) == ("start", (0, 1))
+    kind, key, t = act.next_event(0.0, 1.0)
+    assert (kind, key) == (EventCode.CONTACT_START, (0, 1))
     assert t == pytest.approx((0.2 - 2 * R) / 2.0, rel=1e-9)  # (closed form, head on)
     assert act.set.fresh_rows() == (t, [(R_CONTACT, act.index[(0, 1)])])
     act.now = t
@@ -132,8 +133,8 @@ def test_a_start_returns_its_marker_and_a_rebuilt_set_keeps_it():
     s = act._ready()
     assert act.index[(0, 1)] != 2  # (the pair's index changed: plate pairs come first)
     assert s.fresh_rows() == (t, [(R_CONTACT, act.index[(0, 1)])])
-    kind, key, t_end = act.advance(t, 1.0)
-    assert (kind, key) == ("end", (0, 1)) and t_end > t
+    kind, key, t_end = act.next_event(t, 1.0)
+    assert (kind, key) == (EventCode.CONTACT_END, (0, 1)) and t_end > t
 
 
 def _table(particles, incline):

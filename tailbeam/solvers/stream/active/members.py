@@ -30,13 +30,6 @@ from tailbeam.solvers.stream.active.plate_pairs import PlatePairs
 from tailbeam.solvers.stream.active.rest import excess_energy, place_at_rest, static_height
 from tailbeam.solvers.stream.active.set import ActiveSet
 
-_NAMES = {  # the names ``ActiveMembers.advance`` gives the events
-    EventCode.CONTACT_START: "start",
-    EventCode.CONTACT_END: "end",
-    EventCode.LEAVE: "leave",
-    EventCode.REST: "settle",
-}
-
 
 class ActiveMembers:
     """The members of the active set and their pairs, by ball number and pair key.
@@ -201,12 +194,6 @@ class ActiveMembers:
             return code, key, out.t
         ball = self.members[out.index]
         return code, (ball, EDGES[out.edge]) if code == EventCode.LEAVE else ball, out.t
-
-    def advance(self, t: float, t_stop: float):
-        """``next_event`` with the event named: None (t_stop), ``start``, ``end``,
-        ``leave`` or ``settle``."""
-        code, key, t_new = self.next_event(t, t_stop)
-        return _NAMES.get(code), key, t_new
 
     def steps(self) -> int:
         """Kernel steps so far (accepted)."""
