@@ -1,3 +1,3 @@
 """The package version, read by ``tailbeam.__version__``, the CLI and the basis cache."""
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"

@@ -82,12 +82,11 @@ class ModalPlateSettings:
     residual_flexibility: add the static compliance of the truncated modes at contacts.
     coupling: "two-way" or "one-way" (rigid-plate forces applied to the plate).
     tail: how the truncated modes act at a contact: "quasi-static" (their static compliance),
-    "ritz" (load-dependent Ritz pseudo-modes: on the coupled solver at the balls' first
+    "ritz" (on the single-ball solver load-dependent Ritz pseudo-modes at the balls' first
     contact points, tailbeam.solvers.modal_setup.ritz_prepass; on the stream solver a few
     oscillators at every plate contact, tailbeam.plate.contact_tail; needs
     residual_flexibility and two-way coupling) or "auto" (the default: "ritz" where it
-    applies, the coupled solver on an FE basis with both; "quasi-static" elsewhere, streams
-    included, saying why).
+    applies and its cost is bounded, "quasi-static" elsewhere, saying why).
     tail_modes: Ritz pseudo-modes per contact point, a whole number >= 1, "auto" (chosen per
     point, a posteriori, 0.9-2.5 s per point; the coupled solver only) or None: the solver's
     default, 32 on the coupled solver (within 2e-5 of the full FE at 20 kHz on the default

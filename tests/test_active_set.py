@@ -260,7 +260,7 @@ FLOORS = {"v_in": 1e-3, "v_out": 1e-3, "approach_in": 1e-3, "approach_out": 1e-3
 
 
 def test_contact_records_match_the_reference(scene_pair):
-    """Every ContactRecord field within 1e-6 relative of the reference (floors: 1 mm/s and
+    """Every Impact field within 1e-6 relative of the reference (floors: 1 mm/s and
     1 mm for values near 0), same end kinds, and the leave times (1e-9 s). Measured: 1.1e-9
     (ten balls, c = 0), 3.5e-8 (c = 2000: clamp, ramp, the 3-ball cluster), 1.8e-10 and
     1e-13 s (leaves). (Returning to Python every 0.5 % of the run restarts the step

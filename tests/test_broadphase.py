@@ -1,5 +1,6 @@
-"""Broad phase (tailbeam.solvers.stream.driver.broadphase): the cell grid against brute force, and against
-the actual closest approach of balls moving within their speed bounds (never a missed pair)."""
+"""Broad phase (tailbeam.solvers.stream.driver.broadphase): the cell grid against brute force, and
+against the actual closest approach of balls moving within their speed bounds (never a missed
+pair)."""
 
 import numpy as np
 import pytest

@@ -1,7 +1,7 @@
 """Two-way coupled ball / flexible-plate impacts against independent truths.
 
-Plate: the exact closed-form simply supported Kirchhoff modes (tailbeam.plate.basis), so every
-discrepancy below is the coupled solver's, not the plate model's.
+Plate: the exact closed-form simply supported Kirchhoff modes (tailbeam.plate.closed_forms), so
+every discrepancy below is the coupled solver's, not the plate model's.
 """
 
 import dataclasses

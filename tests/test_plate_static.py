@@ -23,7 +23,7 @@ def test_static_compliance_matches_navier_series(theory, radius):
 
 
 def test_navier_series_agrees_with_modal_module():
-    # the lead's independent Kirchhoff point-load series (tailbeam.plate.basis)
+    # the independent Kirchhoff point-load series (tailbeam.plate.closed_forms)
     ref = ssss_kirchhoff_basis(PLATE, 1000.0).static_compliance_at(POINTS, 0.0)
     np.testing.assert_allclose(
         ssss_static_compliance(PLATE, POINTS, 0.0, "kirchhoff"), ref, rtol=1e-5

@@ -8,7 +8,7 @@ against independent truths, and the fast stream solver against it.
   balls + modes + contacts conserved (a conservation law), with exact and frozen shapes;
 - the fast stream solver (two-way, no residual flexibility) on seven balls (3-ball cluster,
   a stacked pair, oblique landings on the vibrating plate), horizontal and 15 degrees with
-  the damped, clamped law: every ContactRecord field against the reference. The fast
+  the damped, clamped law: every Impact field against the reference. The fast
   solver's model is the reference's "frozen" variant (shapes kept per contact) with shapes
   taken up to SHAPE_TRAVEL / SHAPE_REUSE (1 mm / 0.25 mm) before the touch: it converges to
   the frozen reference as those distances shrink (measured), and with its defaults stays
@@ -135,7 +135,7 @@ def references(request, basis):
 
 
 def test_fast_solver_matches_the_exact_reference(references, basis):
-    """Every ContactRecord field of 14-16 contacts within 5e-3 (relative; times on 1 ms;
+    """Every Impact field of 14-16 contacts within 5e-3 (relative; times on 1 ms;
     measured 8.0e-4 horizontal, 2.4e-3 on 15 degrees): what the fast solver's frozen,
     refreshed mode shapes cost at this band (k_max = 23 /m: a shape taken 1 mm away is ~2 %
     off). The exact and frozen references differ by as much (1.0e-3, 7.6e-4)."""

@@ -2,7 +2,7 @@
 
 - the slow reference (tailbeam.solvers.stream.reference.solver: scipy DOP853 over all balls, every
   pair watched) on scenes with ball-ball contacts, a 3-ball cluster, a stacked pair, the
-  kinks of the damped law and balls leaving over the edges: every ContactRecord field within
+  kinks of the damped law and balls leaving over the edges: every Impact field within
   1e-6 (the issue's rigid-plate bound; measured <= 3.5e-8);
 - the energy ledger with 100+ balls: conserved (c = 0) and never gained (c > 0);
 - closed forms: a ball resting on the frictionless incline slides off at

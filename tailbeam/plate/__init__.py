@@ -1,6 +1,9 @@
-"""Plate modal model: FE (Kirchhoff/Argyris, Reissner-Mindlin/Lagrange P4) natural
-frequencies and unit-modal-mass mode shapes of the rectangular plate, checked against
-closed forms and published tables, with automatic theory/mesh choice and a disk cache.
+"""The plate's modal model: the basis every solver takes (``basis``: natural frequencies,
+unit-modal-mass mode shapes, modal damping), closed forms and published tables (``closed_forms``),
+the finite-element model (``fe``: Kirchhoff/Argyris, Reissner-Mindlin/Lagrange P4, with
+automatic theory and mesh choice), the disk cache (``cache``), the residual compliance of the
+truncated modes (``compliance``) and the tails that stand in for them at a contact
+(``ritz_tail``, ``contact_tail``).
 
     from tailbeam.plate import compute_modes, PlateModel, assemble_plate
 """

@@ -148,10 +148,10 @@ class Impact:
         Height (m) of the ball's lowest point above the plate at the apex of the flight
         that follows (nan if there is none, if the ball touches anything or leaves the
         plate first, for ball-ball rows, and in the FE reference, which does not fly on).
-    end : str
+    end : End
         How the contact ended: ``separated``, ``rest`` (the ball came to rest on the plate:
         the solver's rest rules), ``left`` (the ball left the plate during the contact) or
-        ``duration`` (the simulation ended during it).
+        ``duration`` (the simulation ended during it); equal to these strings.
     """
 
     ball: str
@@ -169,7 +169,7 @@ class Impact:
     t_peak: float = float("nan")
     max_penetration: float = 0.0
     next_apex_height: float = float("nan")
-    end: str = "duration"
+    end: End = End.DURATION
 
     @property
     def restitution(self) -> float:
@@ -177,14 +177,14 @@ class Impact:
         for a plate contact), nan unless the contact ended by separation or rest and
         approach_in > 0 (single-ball solvers: 0.0 for a ball declared at rest in contact,
         where v_out = 0)."""
-        if self.end in ("separated", "rest") and self.approach_in > 0.0:
+        if self.end in (End.SEPARATED, End.REST) and self.approach_in > 0.0:
             return self.approach_out / self.approach_in
         return math.nan
 
     @property
     def ends_at_rest(self) -> bool:
         """True if the ball came to rest on the plate during this contact (end ``rest``)."""
-        return self.end == "rest"
+        return self.end == End.REST
 
     @property
     def duration(self) -> float:
@@ -212,7 +212,7 @@ class Impact:
         """
         x = ball.position[0] + ball.velocity[0] * t_start
         y = ball.position[1] + ball.velocity[1] * t_start
-        end = "rest" if at_rest else ("duration" if math.isnan(v_out) else "separated")
+        end = End.REST if at_rest else (End.DURATION if math.isnan(v_out) else End.SEPARATED)
         return cls(ball=ball.name, partner=PLATE, t_start=t_start, x=x, y=y, v_in=v_in,
                    approach_in=v_in, v_out=v_out, approach_out=v_out, end=end, **other)  # fmt: skip
 
@@ -224,7 +224,6 @@ class Impact:
         return out
 
 
-ContactRecord = Impact  # the stream solvers' former name (same class)
 
 
 @dataclass(frozen=True)

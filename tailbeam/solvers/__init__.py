@@ -1,12 +1,11 @@
-"""Solvers layer: time integration and the searches it needs (broad phase, references).
+"""The solvers of ``tailbeam.simulate``, each following one protocol (``base``):
 
-- ``rigid``: balls on a rigid plate, the Adams IMPACT law (paper section 3) and its reference;
-- ``coupled``: balls on the two-way coupled modal plate, its FE reference, plate loads;
-- ``stream``: the fast stream solver (closed-form flight, broad phase, active sets) and the
-  slow stream reference;
-- ``records``: ``EventKind``, ``Event`` and ``Impact`` (the one contact record), shared by every
-  solver.
-
-Depends on the physics layer (``tailbeam.physics``), the plate (``tailbeam.plate``, through
-``tailbeam.plate.basis``) and the sensor chain (``tailbeam.signals``), never on ``tailbeam.paper``.
+- ``single_ball``: each ball alone with the plate, exact: ``rigid`` (the rigid plate, the
+  paper's model, and its scipy reference) and ``coupled`` (the two-way modal plate, one-way
+  coupling, the full finite-element reference);
+- ``stream``: many balls, ball-ball contact, inclined plates: the fast solver (``solver``,
+  ``driver``, ``active``) and its slow all-pairs ``reference``;
+- shared parts, owned by no solver: ``modal_setup`` (the band, basis, damping and tail of the
+  modal plate, set up from the scene), ``numerics`` (DOP853, Chebyshev root finding,
+  closed-form flight), ``plate_loads`` (the plate's exact response to recorded loads).
 """

@@ -181,8 +181,8 @@ def _submit(client, todo: list) -> dict:
 
 
 def _band_note(toml: str) -> None:
-    """The stream band check (``tailbeam.solvers.modal_setup.band.check_stream_band``) of a basis group's first
-    case, said once: the cases themselves run quietly."""
+    """The stream band check (``tailbeam.solvers.modal_setup.band.check_stream_band``) of a
+    basis group's first case, said once: the cases themselves run quietly."""
     from tailbeam.solvers.modal_setup.band import check_stream_band, stream_band
 
     scene = loads_scene(toml)

@@ -3,7 +3,7 @@
 DOFs are counted exactly from the mesh (nodes of the element), before any assembly.
 Modes: the Weyl-type count of tailbeam.plate.fe.modes (slightly high). Memory and time are
 fitted to measured eigen-solves of the default plate on this project's 2-core machine, one
-BLAS thread, under load (NOTES-band.md, benchmarks/bench_band.py):
+BLAS thread, under load (benchmarks/bench_band.py):
 
     10 kHz:  13 735 DOFs, 112 modes,  1.6 s,  0.19 GB peak
     20 kHz:  29 799 DOFs, 253 modes, 12.4 s

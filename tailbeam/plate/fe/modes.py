@@ -35,8 +35,8 @@ def _blas_threads(requested):
     """Thread limit for BLAS inside the solve: the keyword, else $TAILBEAM_BLAS_THREADS, else
     1. The shift-invert solves (SuperLU) are single-threaded anyway; more BLAS threads only
     speed up the Lanczos orthogonalisation, and on a loaded machine they slowed the whole
-    solve several-fold (default plate to 10 kHz: 23 s with two OpenBLAS threads, 3 s with one;
-    NOTES-band.md)."""
+    solve several-fold (default plate to 10 kHz: 23 s with two OpenBLAS threads, 3 s with
+    one)."""
     if requested is not None:
         return int(requested)
     env = os.environ.get("TAILBEAM_BLAS_THREADS")

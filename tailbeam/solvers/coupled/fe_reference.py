@@ -40,7 +40,6 @@ from tailbeam.results.records import Impact
 DEFAULT_MAX_WORK = 1e11  # steps x 10 x matrix nonzeros; 1e11 is ~1-2 min on one core
 
 
-FEImpact = Impact  # the reference's former record (same class; ``duration`` included)
 
 
 @dataclass

@@ -21,7 +21,7 @@ Band. Two outputs need modes: the sensor signals and the contact forces.
   frequency says), so BAND_SAFETY is calibrated: on exact SSSS modes (independent of the FE
   model) measured / estimate was 0.04-0.85 for 5-40 mm coal and sandstone at 0.5-6 m/s with
   and without contact damping, bands 1/T to 4/T (tests/test_band.py checks four of them); on
-  the FE Mindlin plate of the 30-ball scene see benchmarks/bench_band.py and NOTES-band.md.
+  the FE Mindlin plate of the 30-ball scene see benchmarks/bench_band.py.
   The contacts need the smallest fc >= 1/T with force error <= ``BAND_ACCURACY``. Without
   residual flexibility the modes above fc are missing: error ~ BAND_SAFETY (e/2) C_res / C_c.
 fmax = max(sensor bandwidth, contact band), rounded up to a multiple of BAND_GRID_HZ so that

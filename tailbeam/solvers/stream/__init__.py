@@ -1,5 +1,7 @@
-"""The stream solver: many balls on an inclined plate, rigid or modal (docs/streams.md).
+"""The stream solvers: many balls on an inclined plate, rigid or modal (docs/streams.md).
 
-``stream`` is the fast solver's driver (``solve_stream``); ``engine`` picks it; the slow
-independent reference is ``stream_reference`` (with ``reference_plate`` on the modal plate).
+``solver`` runs them for ``tailbeam.simulate`` (``Stream``, ``StreamReference``); the fast
+solver's event loop is ``driver`` and its compiled integrator of the balls in contact
+``active``; the modal plate between active sets is ``plate``; the slow independent reference is
+``reference``.
 """

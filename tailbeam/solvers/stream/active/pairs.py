@@ -186,8 +186,8 @@ def pair_force(y, n, p, pi, pj, law, rsum, ramp, clamped, phi, mass, g, omega, z
         if law[p, L_CRES] > 0.0 and law[p, LAW_C] > 0.0:  # (delta0'' enters through damping)
             acc, kappa = plate_free_acceleration(y, n, p, pi[p], phi, mass, g, omega, zeta, fdead)
         f, delta, _ = plate_force_with_residual(delta, rate, acc, kappa, law[p, LAW_K],
-                                                law[p, LAW_E], law[p, LAW_C], law[p, LAW_D], ramp[p],
-                                                clamped[p], law[p, L_CRES])  # fmt: skip
+                                                law[p, LAW_E], law[p, LAW_C], law[p, LAW_D],
+                                                ramp[p], clamped[p], law[p, L_CRES])  # fmt: skip
         return f, delta, nx, ny, nz
     f = region_force(
         delta, rate, law[p, LAW_K], law[p, LAW_E], law[p, LAW_C], law[p, LAW_D], ramp[p], clamped[p]
