@@ -1,6 +1,5 @@
 """Meshes with named edges, bad input, and the modal cache."""
 
-
 import meshio
 import numpy as np
 import pytest

@@ -224,8 +224,6 @@ class Impact:
         return out
 
 
-
-
 @dataclass(frozen=True)
 class LeaveEvent:
     """Ball ``ball`` left the plate over ``edge`` (``x+`` downhill, ...) at ``time`` s."""

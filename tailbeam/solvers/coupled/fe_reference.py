@@ -40,8 +40,6 @@ from tailbeam.results.records import Impact
 DEFAULT_MAX_WORK = 1e11  # steps x 10 x matrix nonzeros; 1e11 is ~1-2 min on one core
 
 
-
-
 @dataclass
 class FEReferenceResult:
     """Histories at every step (t (s), force (N), penetration (m)), sensor deflections (m) and
