@@ -9,7 +9,7 @@ import numpy as np
 
 from tailbeam.physics.incline import EDGES
 from tailbeam.physics.pair import pair_kinematics, plate_foot
-from tailbeam.results.records import PLATE, Impact, LeaveEvent
+from tailbeam.results.records import PLATE, EventCode, Impact, LeaveEvent
 from tailbeam.solvers.stream.active.set import ActiveSet
 
 
@@ -100,17 +100,17 @@ class SceneRun:
             out = self.set.advance(t, min(duration, (math.floor(t / sample + 1e-9) + 1) * sample))
             t = out.t
             self.returns.append(out)
-            if out.kind == "contact_start":
+            if out.code == EventCode.CONTACT_START:
                 self.start(out.index, t)
-            elif out.kind == "contact_end":
+            elif out.code == EventCode.CONTACT_END:
                 self.end(out.index, t, "separated")
-            elif out.kind == "leave":
+            elif out.code == EventCode.LEAVE:
                 b = out.index
                 for p in [p for p in self.open if b in (self.set.pi[p], self.set.pj[p])]:
                     self.end(p, t, "left")
                 self.leaves.append(LeaveEvent(self.names[b], t, EDGES[out.edge]))
                 self.set.remove_ball(b)
-            elif out.kind == "settle":
+            elif out.code == EventCode.REST:
                 self.settled.append((self.names[out.index], t))
                 break
             self.record(t)

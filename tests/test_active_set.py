@@ -19,6 +19,7 @@ from numpy.polynomial import chebyshev as cheb
 from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_ball_law, ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.results.records import EventCode
 from tailbeam.solvers.numerics import chebyshev as cheb_events
 from tailbeam.solvers.numerics import step_events
 from tailbeam.solvers.rigid import simulate_rigid
@@ -50,11 +51,11 @@ def test_ball_plate_contact_matches_rigid_solver(damping, exponent):
     t = 0.0
     for imp in rigid.impacts[:2]:
         start = s.advance(t, 1.0)
-        assert start.kind == "contact_start"
+        assert start.code == EventCode.CONTACT_START
         assert start.t == pytest.approx(imp.t_start, rel=1e-10)
         assert -s.v[0, 2] == pytest.approx(imp.v_in, rel=1e-10)
         end = s.advance(start.t, 1.0)
-        assert end.kind == "contact_end"
+        assert end.code == EventCode.CONTACT_END
         assert end.t == pytest.approx(imp.t_end, rel=1e-10)
         assert s.v[0, 2] == pytest.approx(imp.v_out, rel=1e-10)
         for ours, theirs in ((s.peak, imp.peak_force), (s.t_peak, imp.t_peak),
@@ -82,16 +83,16 @@ def test_inclined_contact_keeps_the_closed_form_slide(damping):
     s = _single(ball, law, incline)
     acc = incline.gravity * math.sin(math.radians(theta))
     start = s.advance(0.0, 1.0)
-    assert start.kind == "contact_start"
+    assert start.code == EventCode.CONTACT_START
     times = [start.t]
     for _ in range(100):
         out = s.advance(times[-1], times[-1] + 3e-5)
         times.append(out.t)
         assert s.x[0, 0] == pytest.approx(x0 + v0 * out.t + 0.5 * acc * out.t**2, abs=1e-12)
         assert s.x[0, 1] == 0.01 and s.v[0, 1] == 0.0
-        if out.kind == "contact_end":
+        if out.code == EventCode.CONTACT_END:
             break
-    assert out.kind == "contact_end" and len(times) > 5
+    assert out.code == EventCode.CONTACT_END and len(times) > 5
 
 
 @pytest.fixture(scope="module")
@@ -142,10 +143,10 @@ def test_oblique_collision_keeps_tangential_velocity(damping):
     b = Ball("b", SANDSTONE, 0.02, (0.05, 0.0, 0.1), (-1.0, 0.2, -0.4))
     s = ActiveSet.from_balls([a, b], [(0, 1)], NO_GRAVITY, damping=damping, rtol=1e-12)
     start = s.advance(0.0, 0.06)
-    assert start.kind == "contact_start"
+    assert start.code == EventCode.CONTACT_START
     x0, v0 = s.x.copy(), s.v.copy()
     end = s.advance(start.t, 0.06)
-    assert end.kind == "contact_end"
+    assert end.code == EventCode.CONTACT_END
     plane = np.cross(x0[0] - x0[1], v0[0] - v0[1])
     plane /= np.linalg.norm(plane)
     np.testing.assert_allclose(s.v @ plane, v0 @ plane, rtol=0.0, atol=1e-14)
@@ -193,11 +194,11 @@ def test_grazing_pass_inside_one_step_is_found():
     b = Ball("b", SANDSTONE, r2, (0.0, offset, 0.1), (0.0, 0.0, 0.0))
     s = ActiveSet.from_balls([a, b], [(0, 1)], NO_GRAVITY, rtol=1e-10)
     out = s.advance(0.0, 1.0, h=1e-4)
-    assert out.kind == "contact_start"
+    assert out.code == EventCode.CONTACT_START
     half_chord = math.sqrt((r1 + r2) ** 2 - offset**2)
     assert out.t == pytest.approx((0.2 - half_chord) / speed, rel=1e-9)
     out = s.advance(out.t, 1.0)
-    assert out.kind == "contact_end"
+    assert out.code == EventCode.CONTACT_END
     assert out.t == pytest.approx((0.2 + half_chord) / speed, rel=1e-6)  # (the force acted)
 
 
@@ -215,7 +216,7 @@ def test_leave_time_of_a_sliding_ball_is_the_closed_form():
     assert s.touching[0]
     out = s.advance(0.0, 1.0)
     acc = incline.gravity * math.sin(math.radians(theta))
-    assert out.kind == "leave" and out.index == 0 and out.edge == 1  # "x+"
+    assert out.code == EventCode.LEAVE and out.index == 0 and out.edge == 1  # "x+"
     assert out.t == pytest.approx((-v0 + math.sqrt(v0 * v0 + 2.0 * acc * (0.3 - x0))) / acc,
                                   abs=1e-12)  # fmt: skip
 

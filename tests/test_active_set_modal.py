@@ -17,6 +17,7 @@ from tailbeam.physics.bodies import Ball, Plate
 from tailbeam.physics.contact_law import ball_plate_law, elastic_energy
 from tailbeam.physics.materials import COAL, SANDSTONE
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.results.records import EventCode
 from tailbeam.solvers.coupled import simulate_coupled
 from tailbeam.solvers.plate_loads import propagator
 from tailbeam.solvers.stream.active.set import ActiveSet
@@ -66,7 +67,7 @@ def test_single_ball_matches_the_coupled_solver(damping):
     s = _modal_set(ball, law, zeta=ZETA)
     start = s.advance(0.0, 1e-3)
     end = s.advance(start.t, 1e-3)
-    assert (start.kind, end.kind) == ("contact_start", "contact_end")
+    assert (start.code, end.code) == (EventCode.CONTACT_START, EventCode.CONTACT_END)
     if damping > 0:
         assert [k for _, k, _ in s.kink_log()][:1] == ["full_damping"]
     ours = np.array([end.t, s.v[0, 2], s.peak[0], s.pen[0]])
@@ -89,11 +90,11 @@ def _records(s, t_stop):
     while True:
         o = s.advance(t, t_stop)
         t = o.t
-        if o.kind == "t_stop":
+        if o.code == EventCode.NONE:
             return out
-        assert o.kind in ("contact_start", "contact_end")
+        assert o.code in (EventCode.CONTACT_START, EventCode.CONTACT_END)
         b = int(s.pi[o.index])
-        if o.kind == "contact_start":
+        if o.code == EventCode.CONTACT_START:
             out[b] = [o.t]
         else:
             out[b] += [o.t, s.v[b, 2], s.peak[o.index], s.pen[o.index]]
@@ -149,7 +150,7 @@ def _free_modes(rtol, q0, qd0, zeta, f_dead):
         f_dead=f_dead,
     )  # fmt: skip
     out = s.advance(0.0, 0.02)
-    assert out.kind == "t_stop" and out.t == 0.02
+    assert out.code == EventCode.NONE and out.t == 0.02
     return s
 
 
@@ -203,10 +204,10 @@ def test_energy_is_conserved_without_damping():
     while t < 0.03:
         out = s.advance(t, min(t + 5e-4, 0.03))
         t = out.t
-        kinds.append(out.kind)
+        kinds.append(out.code)
         drift = max(drift, abs(_energy(s, ball, law, g) - e0) / scale)
         modal_max = max(modal_max, s.modal_energy() / scale)
-    assert kinds.count("contact_end") >= 5
+    assert kinds.count(EventCode.CONTACT_END) >= 5
     assert modal_max > 0.5  # the plate really takes part
     assert drift < 1e-9
 
@@ -239,7 +240,7 @@ def test_force_rows_drive_the_modes_as_inside_the_set():
     for nodes in (10, 40):
         s = _modal_set(ball, law, zeta=ZETA, nodes_per_step=nodes)
         start = s.advance(0.0, 1e-3)
-        assert s.advance(start.t, 1e-3).kind == "contact_end"
+        assert s.advance(start.t, 1e-3).code == EventCode.CONTACT_END
         q, qd = _modes_from_rows(s, zeta)
         errors.append([np.linalg.norm(q - s.q) / np.linalg.norm(s.q),
                        np.linalg.norm(qd - s.qd) / np.linalg.norm(s.qd)])  # fmt: skip

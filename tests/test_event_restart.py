@@ -54,7 +54,7 @@ def test_a_row_past_its_crossing_at_the_restart_is_applied_there(fresh):
     never delay an event that is due)."""
     s = _touching_pair(1.5 * BAND, T0, fresh)
     out = s.advance(T0, T0 + 1e-3, h=1e-4)
-    assert (out.kind, out.t) == ("contact_end", T0)
+    assert (out.code, out.t) == (EventCode.CONTACT_END, T0)
     assert s.stats["found_again"] == 0
 
 
@@ -71,10 +71,10 @@ def test_a_carried_row_found_at_the_restart_is_searched_again():
     tau = (BAND - (d * d - (2 * R) ** 2)) / (2.0 * d * 0.02)
     assert 4 * math.ulp(t0) < tau < 4.0 * np.finfo(float).eps * t0  # (the window)
     out = s.advance(t0, t0 + 1e-3, h=1e-4)
-    assert (out.kind, out.t, s.stats["found_again"]) == ("contact_end", t0, 0)
+    assert (out.code, out.t, s.stats["found_again"]) == (EventCode.CONTACT_END, t0, 0)
     s = _touching_pair(0.5 * BAND, t0, fresh=True)
     out = s.advance(t0, t0 + 1e-3, h=1e-4)
-    assert (out.kind, out.t, s.stats["found_again"]) == ("contact_end", t0, 1)
+    assert (out.code, out.t, s.stats["found_again"]) == (EventCode.CONTACT_END, t0, 1)
 
 
 def test_markers_of_another_instant_are_not_carried():
@@ -102,7 +102,7 @@ def test_a_genuine_new_crossing_is_still_found(fresh):
     if fresh:
         s.set_fresh(T0, [(R_CONTACT, 0)])
     out = s.advance(T0, T0 + 1.0, h=1.0)
-    assert out.kind == "contact_start"
+    assert out.code == EventCode.CONTACT_START
     # the landing: z + v t - g t^2 / 2 = R sqrt(1 - 1e-12) (the START crossing, f = -band)
     zc = R * math.sqrt(1.0 - 1e-12)
     t_land = (v + math.sqrt(v * v + 2.0 * g * (z - zc))) / g

@@ -86,14 +86,6 @@ class Outcome:
     index: int = -1
     edge: int = -1
 
-    @property
-    def kind(self) -> str:
-        """The name of ``code``: its ``EventKind`` (``contact_start``, ``contact_end``,
-        ``leave``), ``settle`` for REST and ``t_stop`` for NONE."""
-        if self.code == EventCode.NONE:
-            return "t_stop"
-        return "settle" if self.code == EventCode.REST else self.code.kind
-
 
 def pair_laws(balls, pairs, plate_material, **options):
     """Laws of ``pairs`` ((i, j), j = -1 the plate) of ``balls`` (tailbeam.Ball): their rows
