@@ -42,21 +42,21 @@ class SceneRun:
         self.contacts, self.leaves, self.settled = [], [], []
         self.open = {}
         self.times, self.energy, self.returns, self.states = [], [], [], []
-        for p in np.flatnonzero(self.set.touching):
+        for p in np.flatnonzero(self.set.contacts.touching):
             self.start(int(p), 0.0)
         self.run(duration, sample or duration)
 
     def kin(self, p):
         s = self.set
-        i, j = int(s.pi[p]), int(s.pj[p])
+        i, j = int(s.model.pi[p]), int(s.model.pj[p])
         xj = plate_foot(s.x[i][None]) if j < 0 else s.x[j][None]
         vj = np.zeros((1, 3)) if j < 0 else s.v[j][None]
-        return i, j, pair_kinematics(s.x[i][None], s.v[i][None], xj, vj, [s.rsum[p]])
+        return i, j, pair_kinematics(s.x[i][None], s.v[i][None], xj, vj, [s.model.rsum[p]])
 
     def start(self, p, t):
         i, j, kin = self.kin(p)
         n = kin.normal[0]
-        point = self.set.x[i] - n * (self.set.radius[i] - 0.5 * max(kin.penetration[0], 0.0))
+        point = self.set.x[i] - n * (self.set.model.radius[i] - 0.5 * max(kin.penetration[0], 0.0))
         rate = float(kin.rate[0])
         partner = PLATE if j < 0 else self.names[j]
         recs = [Impact(ball=self.names[i], partner=partner, t_start=t, x=point[0], y=point[1],
@@ -77,21 +77,21 @@ class SceneRun:
             self.finish(rec, p)
 
     def finish(self, rec, p):
-        s = self.set
-        rec.peak_force, rec.t_peak, rec.max_penetration = s.peak[p], s.t_peak[p], s.pen[p]
+        c = self.set.contacts
+        rec.peak_force, rec.t_peak, rec.max_penetration = c.peak[p], c.t_peak[p], c.pen[p]
 
     def record(self, t):
         s = self.set
-        m, alive = s.mass, s.alive
+        m, alive = s.model.mass, s.model.alive
         e = 0.5 * float(np.sum(m[alive, None] * s.v[alive] ** 2))
-        e -= float(np.sum(m[alive] * (s.x[alive] @ s.g)))
-        for p in np.flatnonzero(s.touching):
-            k, ex = s.law[p, 0], s.law[p, 1]
+        e -= float(np.sum(m[alive] * (s.x[alive] @ s.model.g)))
+        for p in np.flatnonzero(s.contacts.touching):
+            k, ex = s.model.law[p, 0], s.model.law[p, 1]
             delta = s.penetration(p)[0]
             e += k * max(delta, 0.0) ** (ex + 1.0) / (ex + 1.0)
         self.times.append(t)
         self.energy.append(e)
-        self.states.append((s.x.copy(), s.v.copy(), s.touching.copy()))
+        self.states.append((s.x.copy(), s.v.copy(), s.contacts.touching.copy()))
 
     def run(self, duration, sample):
         t = 0.0
@@ -106,7 +106,9 @@ class SceneRun:
                 self.end(out.index, t, "separated")
             elif out.code == EventCode.LEAVE:
                 b = out.index
-                for p in [p for p in self.open if b in (self.set.pi[p], self.set.pj[p])]:
+                for p in [
+                    p for p in self.open if b in (self.set.model.pi[p], self.set.model.pj[p])
+                ]:
                     self.end(p, t, "left")
                 self.leaves.append(LeaveEvent(self.names[b], t, EDGES[out.edge]))
                 self.set.remove_ball(b)

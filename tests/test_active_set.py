@@ -58,8 +58,8 @@ def test_ball_plate_contact_matches_rigid_solver(damping, exponent):
         assert end.code == EventCode.CONTACT_END
         assert end.t == pytest.approx(imp.t_end, rel=1e-10)
         assert s.v[0, 2] == pytest.approx(imp.v_out, rel=1e-10)
-        for ours, theirs in ((s.peak, imp.peak_force), (s.t_peak, imp.t_peak),
-                             (s.pen, imp.max_penetration)):  # fmt: skip
+        for ours, theirs in ((s.contacts.peak, imp.peak_force), (s.contacts.t_peak, imp.t_peak),
+                             (s.contacts.pen, imp.max_penetration)):  # fmt: skip
             assert ours[0] == pytest.approx(theirs, rel=1e-10)
         t = end.t
     kinks = [(e.t, e.kind) for e in rigid.events if e.kind not in ("contact_start", "contact_end")]
@@ -213,7 +213,7 @@ def test_leave_time_of_a_sliding_ball_is_the_closed_form():
     ball = Ball("s", COAL, r, (x0, 0.01, r - static_penetration_on(COAL, r, incline)),
                 (v0, 0.0, 0.0))  # fmt: skip
     s = ActiveSet.from_balls([ball], [(0, -1)], incline, rtol=1e-12)
-    assert s.touching[0]
+    assert s.contacts.touching[0]
     out = s.advance(0.0, 1.0)
     acc = incline.gravity * math.sin(math.radians(theta))
     assert out.code == EventCode.LEAVE and out.index == 0 and out.edge == 1  # "x+"
@@ -369,9 +369,10 @@ def test_settle_event():
     assert run.settled and run.settled[0][0] == "a"
     x, v = run.set.x[0], run.set.v[0]
     assert excess(x[2], v[2]) < e_settle
-    pairs = list(zip(run.set.pi.tolist(), run.set.pj.tolist(), strict=True))
+    pairs = list(zip(run.set.model.pi.tolist(), run.set.model.pj.tolist(), strict=True))
     stack = [pairs.index((1, -1)), pairs.index((1, 2))]
-    assert run.set.touching[0] and run.set.touching[stack].all()
+    touching = run.set.contacts.touching
+    assert touching[0] and touching[stack].all()
     earlier = [excess(x[0, 2], v[0, 2]) for x, v, touching in run.states if touching[0]]
     assert len(earlier) > 100 and min(earlier) >= e_settle
     assert sum(c.ball == "a" for c in run.contacts) >= 3  # it bounced before settling

@@ -70,7 +70,7 @@ def test_single_ball_matches_the_coupled_solver(damping):
     assert (start.code, end.code) == (EventCode.CONTACT_START, EventCode.CONTACT_END)
     if damping > 0:
         assert [k for _, k, _ in s.kink_log()][:1] == ["full_damping"]
-    ours = np.array([end.t, s.v[0, 2], s.peak[0], s.pen[0]])
+    ours = np.array([end.t, s.v[0, 2], s.contacts.peak[0], s.contacts.pen[0]])
     a, qa, qda = _coupled(ball, law, 800)
     b, qb, qdb = _coupled(ball, law, 1600)
     extrap = b + (b - a) / 3.0
@@ -93,11 +93,11 @@ def _records(s, t_stop):
         if o.code == EventCode.NONE:
             return out
         assert o.code in (EventCode.CONTACT_START, EventCode.CONTACT_END)
-        b = int(s.pi[o.index])
+        b = int(s.model.pi[o.index])
         if o.code == EventCode.CONTACT_START:
             out[b] = [o.t]
         else:
-            out[b] += [o.t, s.v[b, 2], s.peak[o.index], s.pen[o.index]]
+            out[b] += [o.t, s.v[b, 2], s.contacts.peak[o.index], s.contacts.pen[o.index]]
 
 
 def test_two_balls_share_the_modes_as_in_the_coupled_solver():
@@ -182,9 +182,9 @@ def test_free_modes_follow_the_exact_propagator():
 def _energy(s, ball, law, g):
     """Ball kinetic + potential + contact elastic + modal (kinetic + strain - dead-load work)."""
     delta, _ = s.penetration(0)
-    elastic = elastic_energy(max(delta, 0.0), law) if s.touching[0] else 0.0
+    elastic = elastic_energy(max(delta, 0.0), law) if s.contacts.touching[0] else 0.0
     return (0.5 * ball.mass * s.v[0] @ s.v[0] + ball.mass * g * s.x[0, 2] + elastic
-            + s.modal_energy() - s.f_dead @ s.q)  # fmt: skip
+            + s.modal_energy() - s.model.f_dead @ s.q)  # fmt: skip
 
 
 def test_energy_is_conserved_without_damping():
@@ -223,7 +223,9 @@ def _modes_from_rows(s, zeta):
     for k in range(len(t) - 1):
         if t[k + 1] > t[k]:
             propagator.coefficients(BASIS.omega, zeta, t[k + 1] - t[k], coef)
-            propagator.advance(coef, q, qd, -s.phi[0] * f[k], -s.phi[0] * f[k + 1], q1, qd1)
+            propagator.advance(
+                coef, q, qd, -s.model.phi[0] * f[k], -s.model.phi[0] * f[k + 1], q1, qd1
+            )
             q, qd = q1.copy(), qd1.copy()
     return q, qd
 

@@ -41,9 +41,9 @@ def _touching_pair(f0: float, t0: float, fresh: bool) -> ActiveSet:
         [(0.0, 0.0, 0.1), (d, 0.0, 0.1)], [(-0.01, 0.0, 0.0), (0.01, 0.0, 0.0)],
         [mass, mass], [R, R], [(0, 1)], [law], (0.0, 0.0, 0.0), (0.3, 0.3), rtol=1e-10,
     )  # fmt: skip
-    s.touching[0] = True
+    s.contacts.touching[0] = True
     if fresh:
-        s.set_fresh(t0, [(R_CONTACT, 0)])
+        s.io.set_fresh(t0, [(R_CONTACT, 0)])
     return s
 
 
@@ -81,7 +81,7 @@ def test_markers_of_another_instant_are_not_carried():
     """Markers apply only to a restart at the instant they were applied at."""
     t0 = 1000.0
     s = _touching_pair(0.5 * BAND, t0, fresh=False)
-    s.set_fresh(t0 - 1e-4, [(R_CONTACT, 0)])
+    s.io.set_fresh(t0 - 1e-4, [(R_CONTACT, 0)])
     s.advance(t0, t0 + 1e-3, h=1e-4)
     assert s.stats["found_again"] == 0
 
@@ -100,7 +100,7 @@ def test_a_genuine_new_crossing_is_still_found(fresh):
     s = ActiveSet([ball.position], [ball.velocity], [ball.mass], [R], [(0, -1)], [law],
                   incline.gravity_vector, incline.half_sizes, rtol=1e-10)  # fmt: skip
     if fresh:
-        s.set_fresh(T0, [(R_CONTACT, 0)])
+        s.io.set_fresh(T0, [(R_CONTACT, 0)])
     out = s.advance(T0, T0 + 1.0, h=1.0)
     assert out.code == EventCode.CONTACT_START
     # the landing: z + v t - g t^2 / 2 = R sqrt(1 - 1e-12) (the START crossing, f = -band)
@@ -127,12 +127,12 @@ def test_a_start_returns_its_marker_and_a_rebuilt_set_keeps_it():
     kind, key, t = act.next_event(0.0, 1.0)
     assert (kind, key) == (EventCode.CONTACT_START, (0, 1))
     assert t == pytest.approx((0.2 - 2 * R) / 2.0, rel=1e-9)  # (closed form, head on)
-    assert act.set.fresh_rows() == (t, [(R_CONTACT, act.index[(0, 1)])])
+    assert act.set.io.fresh_rows() == (t, [(R_CONTACT, act.index[(0, 1)])])
     act.now = t
     act.add(2, particles[2].position, particles[2].velocity, quiet=False)  # (a rebuild)
     s = act._ready()
     assert act.index[(0, 1)] != 2  # (the pair's index changed: plate pairs come first)
-    assert s.fresh_rows() == (t, [(R_CONTACT, act.index[(0, 1)])])
+    assert s.io.fresh_rows() == (t, [(R_CONTACT, act.index[(0, 1)])])
     kind, key, t_end = act.next_event(t, 1.0)
     assert (kind, key) == (EventCode.CONTACT_END, (0, 1)) and t_end > t
 
@@ -146,6 +146,6 @@ def test_set_fresh_keeps_at_most_the_kernel_capacity():
     from tailbeam.solvers.stream.active.kernel import MAX_FRESH
 
     s = _touching_pair(0.5 * BAND, T0, fresh=False)
-    s.set_fresh(T0, [(R_CONTACT, 0)] * (MAX_FRESH + 3))
-    assert len(s.fresh_rows()[1]) == MAX_FRESH
-    assert np.all(s.fresh[:, 0] == R_CONTACT)
+    s.io.set_fresh(T0, [(R_CONTACT, 0)] * (MAX_FRESH + 3))
+    assert len(s.io.fresh_rows()[1]) == MAX_FRESH
+    assert np.all(s.io.fresh[:, 0] == R_CONTACT)

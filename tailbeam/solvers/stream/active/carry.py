@@ -1,7 +1,7 @@
 """The rows whose events were just applied, carried by key across rebuilds of the set.
 
 An ``ActiveSet`` hands back the rows (kind, index) whose events it applied at the time it
-returned at (``ActiveSet.fresh_rows``), so that a call restarting there does not apply the
+returned at (``KernelIO.fresh_rows``), so that a call restarting there does not apply the
 same event again at once (``kernel.advance``). The driver's set is rebuilt with other
 indices when its members change: the rows are kept here by pair key, or (ball, edge) for an
 edge row, and given to the rebuilt set under its own indices.
@@ -21,7 +21,7 @@ class CarriedRows:
 
     def save(self, s, members, keys) -> None:
         """Keep the fresh rows of ``s`` (an ``ActiveSet`` of ``members``, pairs ``keys``)."""
-        t, rows = s.fresh_rows()
+        t, rows = s.io.fresh_rows()
         self.t = t
         self.rows = [(k, (members[i // 4], i % 4) if k == R_EDGE else keys[i]) for k, i in rows]
 
@@ -35,4 +35,4 @@ class CarriedRows:
                     kept.append((k, 4 * local[key[0]] + key[1]))
             elif key in index:
                 kept.append((k, index[key]))
-        s.set_fresh(self.t, kept)
+        s.io.set_fresh(self.t, kept)

@@ -14,8 +14,6 @@ Its parts: the plate force histories (``forces.PlateForces``), putting a member 
 (``plate_pairs.PlatePairs``).
 """
 
-import math
-
 import numpy as np
 
 from tailbeam.physics.contact_law import law_table
@@ -24,7 +22,6 @@ from tailbeam.physics.incline import EDGES
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.stream.active.carry import CarriedRows
 from tailbeam.solvers.stream.active.forces import PlateForces
-from tailbeam.solvers.stream.active.kernel import IO_AGAIN, IO_ATTEMPTS, IO_NFEV, IO_STEPS
 from tailbeam.solvers.stream.active.pairs import first_contact_step
 from tailbeam.solvers.stream.active.plate_pairs import PlatePairs
 from tailbeam.solvers.stream.active.rest import excess_energy, place_at_rest, static_height
@@ -110,7 +107,7 @@ class ActiveMembers:
             return
         for q, i in enumerate(self.members):
             self._x[i], self._v[i] = s.x[q].copy(), s.v[q].copy()
-        self._pairs = {k: _pair_state(s, p) for k, p in self.index.items()}
+        self._pairs = {k: s.contacts.of(p) for k, p in self.index.items()}
         self.carried.save(s, self.members, self.keys)
         if self.modal is not None:  # each plate pair keeps its mode shapes (its contact point)
             self.modal.save(s, self.index)
@@ -142,7 +139,7 @@ class ActiveMembers:
         self.index = {k: p for p, k in enumerate(self.keys)}
         for k, p in self.index.items():
             if k in old:
-                s.touching[p], s.ramp[p], s.clamped[p], s.peak[p], s.t_peak[p], s.pen[p] = old[k]
+                s.contacts.put(p, old[k])
         s.h = self.h
         self.local = local
         if old:
@@ -158,8 +155,7 @@ class ActiveMembers:
             self.totals["kernel_attempts"] += st["attempts"]
             self.totals["kernel_nfev"] += st["nfev"]
             self.totals["events_found_again"] += st["found_again"]
-            for io in (IO_STEPS, IO_ATTEMPTS, IO_NFEV, IO_AGAIN):
-                self.set.iout[io] = 0
+            self.set.io.reset_stats()
 
     # --- integration ------------------------------------------------------------------------
     def next_event(self, t: float, t_stop: float):
@@ -222,8 +218,8 @@ class ActiveMembers:
         what a contact among them can give to one of them."""
         s = self._ready()
         q = [self.local[int(i)] for i in balls]
-        kinetic = 0.5 * float(np.sum(s.mass[q] * np.sum(s.v[q] * s.v[q], axis=1)))
-        elastic = sum(s.contact_energy(p) for p in np.flatnonzero(s.touching))
+        kinetic = 0.5 * float(np.sum(s.model.mass[q] * np.sum(s.v[q] * s.v[q], axis=1)))
+        elastic = sum(s.contact_energy(p) for p in np.flatnonzero(s.contacts.touching))
         return kinetic + elastic
 
     def elastic_energy_of(self, i: int) -> float:
@@ -239,32 +235,30 @@ class ActiveMembers:
     def touching_pairs(self, i: int) -> list:
         """Keys of member i's pairs in contact now."""
         s = self._ready()
-        return [k for k, p in self.index.items() if i in k[:1] + k[1:] and s.touching[p]]
+        touching = s.contacts.touching
+        return [k for k, p in self.index.items() if i in k[:1] + k[1:] and touching[p]]
 
     # --- contacts ---------------------------------------------------------------------------
     def start_contact(self, key):
         """Pair ``key`` starts touching now (its start was found in closed form)."""
         s = self._ready()
         p = self.index[key]
-        delta, _ = s.penetration(p)
-        s.touching[p], s.ramp[p], s.clamped[p] = True, True, False
-        s.peak[p], s.t_peak[p], s.pen[p] = 0.0, math.nan, max(delta, 0.0)
-        s.forget_fresh(p)
+        s.contacts.start(p, s.penetration(p)[0])
+        s.io.forget_fresh(p)
         self._set_compliance(key)
-        step = first_contact_step(s.y, s.model(), p, self.rtol)
+        step = first_contact_step(s.y, s.model.arrays(), p, self.rtol)
         self.h = min(self.h, step) if self.h else step
 
     def reset_accumulators(self, key):
         """Peak force and maximum penetration of pair ``key`` start again from now."""
         s = self._ready()
         p = self.index[key]
-        s.peak[p], s.t_peak[p], s.pen[p] = 0.0, math.nan, max(s.penetration(p)[0], 0.0)
+        s.contacts.reset_accumulators(p, s.penetration(p)[0])
 
     def accumulators(self, key):
         """(peak force N, its time s, maximum penetration m) of pair ``key``."""
         s = self._ready()
-        p = self.index[key]
-        return float(s.peak[p]), float(s.t_peak[p]), float(s.pen[p])
+        return s.contacts.accumulators(self.index[key])
 
     def make_quiet(self, i: int) -> float:
         """Put ball i at rest on the plate (``rest``); returns the normal excess energy (J)
@@ -276,7 +270,7 @@ class ActiveMembers:
         if self.modal is not None:  # at rest: the static spring of the whole tail, no oscillators
             w, wd = self.modal.deflection(s, p)
             cres = self.modal.compliance((i, -1))
-            s.set_compliance(p, cres)
+            s.model.set_compliance(p, cres)
         place_at_rest(s, q, p, static_height(self.balls, i, cres) + w, wd,
                       self.balls.static_pen[i])  # fmt: skip
         self.quiet.add(i)
@@ -288,7 +282,7 @@ class ActiveMembers:
         if i in self.quiet:
             self.quiet.discard(i)
             s = self._ready()
-            s.settle_energy[self.local[i]] = self.settle_energy(i)
+            s.model.settle_energy[self.local[i]] = self.settle_energy(i)
 
     # --- the modal plate's pairs (``plate_pairs``) ------------------------------------------
     def refresh_shapes(self):
@@ -297,7 +291,8 @@ class ActiveMembers:
         if self.modal is None or not self.members:
             return
         s = self._ready()
-        free = [(q, i) for q, i in enumerate(self.members) if not s.touching[self.index[(i, -1)]]]
+        touching = s.contacts.touching
+        free = [(q, i) for q, i in enumerate(self.members) if not touching[self.index[(i, -1)]]]
         if not free:
             return
         for key in self.modal.refresh(s, free, self.index):  # (after the set's own changes:
@@ -307,7 +302,7 @@ class ActiveMembers:
         """Modal plate: plate pair ``key`` (touching from now) gets its tail (``_start_tail``)
         or its residual compliance."""
         if self.modal is not None and key[1] < 0 and not self._start_tail(key):
-            self.set.set_compliance(self.index[key], self.modal.compliance(key))
+            self.set.model.set_compliance(self.index[key], self.modal.compliance(key))
 
     def _start_tail(self, key) -> bool:
         """Plate pair ``key`` (touching from now) gets the oscillators of its contact point, at
@@ -316,12 +311,12 @@ class ActiveMembers:
         refreshed since) keeps its oscillators, still moving. False without a tail."""
         tails = self.modal.tails
         if key in tails:
-            self.set.set_compliance(self.index[key], tails.modes(key).compliance)
+            self.set.model.set_compliance(self.index[key], tails.modes(key).compliance)
             return True
         tail = self.modal.new_tail(key)
         if tail is None:
             return False
-        self.set.set_compliance(self.index[key], tail.compliance)
+        self.set.model.set_compliance(self.index[key], tail.compliance)
         self._sync()
         self.modal.add_tail(key, tail)
         self.dirty = True
@@ -349,8 +344,3 @@ class ActiveMembers:
         if self.modal.tails.states:
             self._sync()
         return self.modal.tails.energy()
-
-
-def _pair_state(s, p) -> tuple:
-    """(touching, ramp, clamped, peak, t_peak, pen) of pair p of ``s`` (an ``ActiveSet``)."""
-    return (s.touching[p], s.ramp[p], s.clamped[p], s.peak[p], s.t_peak[p], s.pen[p])

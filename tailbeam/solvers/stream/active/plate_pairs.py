@@ -48,9 +48,9 @@ class PlatePairs:
         """Keep the shapes, compliance and tail states of the plate pairs of ``s`` (the built
         ``ActiveSet``; ``index``: pair key -> its pair)."""
         n = self.plate.n_modes
-        self.kept_phi = {k: s.phi[p, :n].copy() for k, p in index.items() if k[1] < 0}
+        self.kept_phi = {k: s.model.phi[p, :n].copy() for k, p in index.items() if k[1] < 0}
         self.tails.save(s.q, s.qd)
-        self.kept_cres = {k: s.law[p, L_CRES] for k, p in index.items() if k[1] < 0}
+        self.kept_cres = {k: s.model.law[p, L_CRES] for k, p in index.items() if k[1] < 0}
         self.points = {k: xy for k, xy in self.points.items() if k in self.kept_phi}
 
     def block(self, members, keys, x, quiet, now) -> dict:
@@ -106,14 +106,14 @@ class PlatePairs:
             The keys of the pairs given new shapes (their tails are to be dropped).
         """
         shapes, points = self.cache.shapes([i for _, i in free], [s.x[q, :2] for q, _ in free])
-        moved = []
+        moved, phi = [], s.model.phi
         for (_, i), shape, xy in zip(free, shapes, points, strict=True):
             p = index[(i, -1)]
             gap = -s.penetration(p)[0]
             n = len(shape)
-            if gap > abs((shape - s.phi[p, :n]) @ s.q[:n] - s.phi[p, n:] @ s.q[n:]) + 1e-9:
-                s.set_phi(p, np.concatenate([shape, np.zeros(s.phi.shape[1] - n)]))
-                s.set_compliance(p, 0.0)  # (set when its contact starts)
+            if gap > abs((shape - phi[p, :n]) @ s.q[:n] - phi[p, n:] @ s.q[n:]) + 1e-9:
+                s.model.set_phi(p, np.concatenate([shape, np.zeros(phi.shape[1] - n)]))
+                s.model.set_compliance(p, 0.0)  # (set when its contact starts)
                 self.points[(i, -1)] = xy
                 moved.append((i, -1))
         return moved
@@ -122,7 +122,8 @@ class PlatePairs:
         """Deflection (m) and its rate (m/s) of the plate's modes under plate pair p of ``s``
         (an ``ActiveSet``; the tails' oscillators excluded)."""
         n = self.plate.n_modes
-        return s.phi[p, :n] @ s.q[:n], s.phi[p, :n] @ s.qd[:n]
+        phi = s.model.phi
+        return phi[p, :n] @ s.q[:n], phi[p, :n] @ s.qd[:n]
 
     def compliance(self, key) -> float:
         """Residual compliance (m/N) of plate pair ``key`` at the point of its mode shapes."""

@@ -7,7 +7,6 @@ of that penetration. The normal motion above this state is removed; the energy i
 returned for the driver's ledger.
 """
 
-from tailbeam.physics.contact_law import LAW_C, LAW_D
 from tailbeam.solvers.stream.active.pairs import settle_excess
 
 
@@ -31,10 +30,9 @@ def excess_energy(s, q: int, p: int) -> float:
     """Energy (J) removed by putting ball q of ``s`` (an ``ActiveSet``) at rest: its normal
     excess energy over the static state while its plate pair p touches, else (a slow
     rebound) the energy of its normal motion."""
-    removed = float(settle_excess(s.y, s.model(), p, q)) if s.touching[p] else 0.0
-    if not s.touching[p]:
-        removed = 0.5 * s.mass[q] * s.v[q, 2] ** 2
-    return removed
+    if not s.contacts.touching[p]:
+        return 0.5 * s.model.mass[q] * s.v[q, 2] ** 2
+    return float(settle_excess(s.y, s.model.arrays(), p, q))
 
 
 def place_at_rest(s, q: int, p: int, height: float, speed: float, static_pen: float) -> None:
@@ -44,9 +42,6 @@ def place_at_rest(s, q: int, p: int, height: float, speed: float, static_pen: fl
     fresh."""
     s.x[q, 2] = height
     s.v[q, 2] = speed
-    law = s.law[p]
-    s.touching[p] = True
-    s.ramp[p] = static_pen < law[LAW_D] or law[LAW_C] <= 0.0
-    s.clamped[p] = False
-    s.settle_energy[q] = 0.0
-    s.forget_fresh(p)
+    s.contacts.hold(p, static_pen, s.model.law[p])
+    s.model.settle_energy[q] = 0.0
+    s.io.forget_fresh(p)
