@@ -1,6 +1,6 @@
 """Whether two sweep output folders hold the same dataset (a speed change's check).
 
-    python benchmarks/compare_sweep_datasets.py DIR_A DIR_B
+    python tools/compare_sweep_datasets.py DIR_A DIR_B
 
 Compares ``dataset.zarr`` (signals, coordinates, attributes: ``xarray.testing.assert_identical``),
 ``impacts.parquet`` and ``cases.csv`` (exactly), after ordering the cases by their hash and
