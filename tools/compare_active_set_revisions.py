@@ -20,7 +20,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from revisions import ROOT, extract_revision, from_either, plain, run_in
+from revisions import ROOT, extract_revision, from_either, run_in, write_plain
 
 SCENES = (("ten-ball c=0", "ten_ball_scene", 15.0, {"damping": 0.0}),
           ("ten-ball c=2000", "ten_ball_scene", 15.0, {"damping": 2000.0, "penetration": 2e-5}),
@@ -46,8 +46,8 @@ def run_scenes(out_path):
         result = {"y": s.y.copy(), "rows": s.force_rows().copy(), "log": s.kink_log(),
                   "stats": s.stats, "contacts": list(run.contacts),
                   "energy": np.array(run.energy), "times": np.array(run.times)}  # fmt: skip
-        out[name] = plain(result)
-    Path(out_path).write_bytes(pickle.dumps(out))
+        out[name] = result
+    write_plain(out, out_path)
 
 
 def _records(records, keys) -> list:
@@ -59,7 +59,8 @@ def _records(records, keys) -> list:
 def differences(a, b) -> list:
     """What differs between two revisions' results of one scene (empty: bit-identical). The
     work counters and the record fields are compared on the keys both revisions have."""
-    out = [k for k in ("y", "rows", "energy", "times") if not np.array_equal(a[k], b[k])]
+    arrays = ("y", "rows", "energy", "times")
+    out = [k for k in arrays if not np.array_equal(a[k], b[k], equal_nan=True)]
     out += ["kink log"] * (repr(a["log"]) != repr(b["log"]))
     records = a["contacts"] + b["contacts"]
     shared = set.intersection(*(set(r) for r in records)) if records else set()

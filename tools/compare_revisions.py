@@ -40,7 +40,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from revisions import ROOT, extract_revision, from_either, plain, run_in
+from revisions import ROOT, extract_revision, from_either, plain, run_in, write_plain
 
 
 def _columns(obj, prefix, out):
@@ -167,7 +167,7 @@ def run_solvers(out_path, quick):
     for name, result in runs.items():
         flat[name] = {}
         _columns(plain(result), "", flat[name])
-    Path(out_path).write_bytes(pickle.dumps(flat))
+    write_plain(flat, out_path)
 
 
 def compare(a: dict, b: dict) -> tuple:

@@ -12,6 +12,8 @@ the parent can read it whatever module paths the other tree has.
 import dataclasses
 import enum
 import importlib
+import pickle
+import pickletools
 import subprocess
 import sys
 import tarfile
@@ -70,6 +72,17 @@ def plain(obj):
     if hasattr(obj, "dtype") and getattr(obj, "shape", None) == ():
         return obj.item()  # a numpy scalar
     return obj
+
+
+def write_plain(obj, path) -> None:
+    """Pickle ``plain(obj)`` to ``path``; refuse if the pickle still names a tailbeam class
+    (the other tree may not have its module)."""
+    data = pickle.dumps(plain(obj))
+    names = [arg for op, arg, _ in pickletools.genops(data) if "GLOBAL" in op.name]
+    strings = [arg for op, arg, _ in pickletools.genops(data) if isinstance(arg, str)]
+    if any("tailbeam" in str(n) for n in names) or any(s.startswith("tailbeam.") for s in strings):
+        raise TypeError(f"{path}: the results still refer to a tailbeam class")
+    Path(path).write_bytes(data)
 
 
 def run_in(tree: Path, cache: Path, call: str) -> None:
