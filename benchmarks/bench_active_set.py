@@ -1,26 +1,28 @@
-"""The active-set integrator's speed against error, beside tailbeam.solvers.rigid's kernel (same
-run).
+"""The stream solver's compiled active set: cost per contact against error, and per step
+against the number of balls.
 
     python benchmarks/bench_active_set.py --out DIR [--quick]
 
-1. Per contact: an isolated coal ball (30 mm) striking the plate at 2 m/s, c = 0, g = 0, so
-   the Hertz closed form (tailbeam.physics.hertz) is the truth. For rtol in 1e-8, 1e-10, 1e-12:
-   wall time per contact (best of 5 x 50 contacts) and the worst relative error of peak
-   force, duration, max penetration and v_out of
-   - ``ActiveSet.advance`` from contact START to END (the contact part; one Python call), and
-   - tailbeam.solvers.rigid's contact integrator (``rigid.solver._KernelIntegrator``: its compiled
-     1-D DOP853 kernel on the penetration ODE plus its thin Python wrapper), the baseline.
-   Steps and right-hand-side evaluations per contact are reported too. The active set
-   integrates the 3-D state of the ball (6 components) and watches 1 pair + 4 edges, the
-   rigid kernel a 2-component ODE: its cost per step is the floor.
-2. Per step against n: n balls resting on a 15 deg plate (``resting_set``), all n plate
-   pairs touching, plus
-   either the n - 1 neighbour ball-ball pairs (P = 2n - 1: the driver's case) or all
-   n (n - 1) / 2 ball-ball pairs (the O(P) term). Time per accepted step (best of 3 runs of
-   2 ms of simulated time) and the fitted exponent of time against n.
+Reproduces the active-set rows of docs/streams.md ("The parts, measured").
 
-Writes DIR/bench_active_set.csv, DIR/bench_active_set_steps.csv and DIR/table.md. Run
-single-threaded (OMP_NUM_THREADS=1). The first run compiles the kernels (not timed).
+1. Per contact: an isolated coal ball (30 mm) striking the plate at 2 m/s, c = 0, g = 0, so
+   the Hertz closed form (tailbeam.physics.hertz) is the truth. For rtol 1e-8, 1e-10, 1e-12:
+   wall time per contact (best of 5 x 50 contacts) and the worst relative error of peak
+   force, duration, max penetration and v_out of ``ActiveSet.advance`` from contact start to
+   end (one Python call), and, the baseline in the same run, of the rigid solver's contact
+   integrator (``tailbeam.solvers.rigid.solver._KernelIntegrator``: its compiled 1-D DOP853
+   kernel on the penetration ODE with its thin Python wrapper). Steps and right-hand-side
+   evaluations per contact too. The active set integrates the ball's 3-D state (6
+   components) and watches 1 pair and 4 edges, the rigid kernel a 2-component ODE: its cost
+   per step is the floor.
+2. Per step against n: n balls resting on a 15 deg plate (``resting_set``), all n plate
+   pairs touching, plus either the n - 1 neighbour ball-ball pairs (P = 2n - 1: the stream
+   driver's case) or all n (n - 1) / 2 ball-ball pairs (the O(P) term). Time per accepted
+   step (best of 3 runs of 2 ms of simulated time) and the fitted exponent of time against n.
+
+``--quick``: 2 repeats, n up to 32. Writes DIR/bench_active_set.csv,
+DIR/bench_active_set_steps.csv and DIR/table.md. Run single-threaded (OMP_NUM_THREADS=1). The
+first run compiles the kernels (not timed).
 """
 
 import argparse

@@ -1,26 +1,22 @@
-"""The active set's two-way modal plate: cost per contact against error, and what leaving out
-the residual flexibility costs.
+"""The stream solver's compiled active set on the two-way modal plate: cost per contact
+against error, beside the coupled single-ball solver.
 
     python benchmarks/bench_active_set_modal.py --out DIR [--quick]
 
-A sandstone ball (30 mm) strikes the 0.6 x 0.6 x 0.01 m simply supported steel plate at
-(0.07, -0.05) m at 2 m/s (c = 0, g = 9.81, modal damping 1 %); plate: the closed-form
-Kirchhoff modes (tailbeam.plate.closed_forms.ssss_kirchhoff_basis) truncated to m modes.
+Reproduces the modal-plate table of docs/streams.md ("The parts, measured"). A sandstone ball
+(30 mm) strikes the 0.6 x 0.6 x 0.01 m simply supported steel plate at (0.07, -0.05) m at
+2 m/s (c = 0, g = 9.81, modal damping 1 %); plate: the closed-form Kirchhoff modes
+(tailbeam.plate.closed_forms.ssss_kirchhoff_basis) truncated to m = 0 (the rigid plate), 25
+and 100 modes, without residual flexibility. Cost per contact (start to end, best of 3 x 20
+contacts; ``--quick``: 2) at rtol 1e-8, 1e-10, 1e-12, and the worst relative error of
+t_end, v_out and peak force against ``simulate_coupled`` on the same m modes,
+Richardson-extrapolated from 1600 and 3200 steps per contact (the same model: the error is
+the integrator's; on the rigid plate the active set itself at rtol 1e-13). Baseline, in the
+same run: ``simulate_coupled`` itself at its default 200 steps per contact (the whole 0.6 ms
+run, one contact) and its error against the same truth.
 
-1. Cost per contact (START -> END, best of 3 x 20 contacts) against error, m = 0 (rigid
-   plate), 25 and 100 modes, rtol 1e-8 / 1e-10 / 1e-12. Error: worst relative error of
-   t_end, v_out and peak force against ``simulate_coupled`` on the same m modes without
-   residual flexibility, Richardson-extrapolated from 1600 and 3200 steps per contact (the
-   same model: the error is the integrator's). Baseline in the same run: ``simulate_coupled``
-   itself at its default 200 steps per contact (whole 0.6 ms run, one contact; its error
-   against the same truth).
-2. Residual flexibility: t_end, v_out, peak and max penetration with m = 25, 52, 100 modes,
-   without residual flexibility (the active set) and with it (``simulate_coupled``), against
-   the converged plate: ``simulate_coupled`` with residual flexibility on all modes below
-   40 kHz (its distance to the 20 kHz run is printed as the truth's own uncertainty).
-
-Writes DIR/bench_active_set_modal.csv, DIR/bench_residual.csv, DIR/table.md. Run
-single-threaded (OMP_NUM_THREADS=1). The first calls compile the kernels (not timed).
+Writes DIR/bench_active_set_modal.csv and DIR/table.md. Run single-threaded
+(OMP_NUM_THREADS=1). The first calls compile the kernels (not timed).
 """
 
 import argparse
@@ -42,7 +38,6 @@ RADIUS, SPEED, G, ZETA, XY = 0.03, 2.0, 9.81, 0.01, (0.07, -0.05)
 PLATE = Plate()
 BALL = Ball("s", SANDSTONE, RADIUS, (XY[0], XY[1], RADIUS + 1e-4), (0.0, 0.0, -SPEED))
 LAW = ball_plate_law(SANDSTONE, RADIUS, PLATE.material, damping=0.0)
-FIELDS = ("t_end", "v_out", "peak", "pen")
 
 
 def basis_of(m):
@@ -96,10 +91,10 @@ def truth_of(basis):
     return b + (b - a) / 3.0
 
 
-def rigid_truth(rtol):
+def rigid_truth():
     """The rigid plate: the active set itself at rtol 1e-13 (tests/test_active_set.py checks
     it against tailbeam.solvers.rigid to 2e-11)."""
-    return active_contact(None, 1e-13, 1)[1] if rtol else None
+    return active_contact(None, 1e-13, 1)[1]
 
 
 def _err(values, truth):
@@ -110,7 +105,7 @@ def per_contact(quick):
     rows = []
     for m in (0, 25, 100):
         basis = basis_of(m)
-        truth = rigid_truth(1) if m == 0 else truth_of(basis)
+        truth = rigid_truth() if m == 0 else truth_of(basis)
         active_contact(basis, 1e-10, 1)  # compile / warm
         for rtol in (1e-8, 1e-10, 1e-12):
             sec, values, steps = active_contact(basis, rtol, 2 if quick else 3)
@@ -128,24 +123,6 @@ def per_contact(quick):
     return rows
 
 
-def residual(quick):
-    full = ssss_kirchhoff_basis(PLATE, 40000.0)
-    truth, _ = coupled(full, 1600, True)
-    half, _ = coupled(ssss_kirchhoff_basis(PLATE, 20000.0), 1600, True)
-    rows = [{"model": f"truth uncertainty ({ssss_kirchhoff_basis(PLATE, 20000.0).n_modes} "
-             f"vs {full.n_modes} modes, residual)", "modes": full.n_modes,
-             **dict(zip(FIELDS, np.abs(half / truth - 1.0), strict=True))}]  # fmt: skip
-    for m in (25, 52) if quick else (25, 52, 100):
-        basis = basis_of(m)
-        values = active_contact(basis, 1e-12, 1)[1]
-        with_res, _ = coupled(basis, 1600, True)
-        for name, v in (("active set (no residual)", values), ("coupled, residual", with_res)):
-            rows.append({"model": name, "modes": m,
-                         **dict(zip(FIELDS, np.abs(v / truth - 1.0), strict=True))})  # fmt: skip
-            print(rows[-1], flush=True)
-    return rows
-
-
 def _write(path, rows):
     with open(path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
@@ -154,23 +131,16 @@ def _write(path, rows):
 
 
 def main(out_dir, quick=False):
-    contact_rows = per_contact(quick)
-    residual_rows = residual(quick)
+    rows = per_contact(quick)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    _write(out / "bench_active_set_modal.csv", contact_rows)
-    _write(out / "bench_residual.csv", residual_rows)
+    _write(out / "bench_active_set_modal.csv", rows)
     lines = ["| solver | modes | setting | us / contact | max rel. error (t_end, v_out, peak) | "
              "steps |", "|---|---|---|---|---|---|"]  # fmt: skip
-    for r in contact_rows:
+    for r in rows:
         lines.append(f"| {r['solver']} | {r['modes']} | {r['setting']} | "
                      f"{r['us_per_contact']:.1f} | {r['max_rel_error']:.1e} | "
                      f"{r['steps']} |")  # fmt: skip
-    lines += ["", "| model | modes | t_end | v_out | peak | max penetration |",
-              "|---|---|---|---|---|---|"]  # fmt: skip
-    for r in residual_rows:
-        lines.append(f"| {r['model']} | {r['modes']} | " + " | ".join(
-            f"{r[k]:.1e}" for k in FIELDS) + " |")  # fmt: skip
     (out / "table.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
@@ -178,6 +148,6 @@ def main(out_dir, quick=False):
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True, help="output folder")
-    parser.add_argument("--quick", action="store_true", help="fewer repeats and mode counts")
+    parser.add_argument("--quick", action="store_true", help="fewer repeats")
     args = parser.parse_args()
     main(args.out, args.quick)

@@ -1,22 +1,26 @@
-"""The automatic modal band: speed against error on the 30-ball scene, with a converged run.
+"""The automatic modal band on 30 balls: speed against error, with a converged run as truth.
 
     python benchmarks/bench_band.py --out DIR [--quick]
 
-Scene: examples/thirty_balls_modal.toml (30 coal and sandstone balls, radius 10-40 mm, 3 m/s,
-on a 6 x 5 grid of the default SSSS steel plate; two sensors at 51.2 kHz, 20 kHz band).
-Rows:
-- "auto": default settings (the band, theory and mesh tailbeam.solvers.modal_setup.band chooses);
+Reproduces the figure of docs/band-and-cost.md ("How good the choice is: 30 balls"). Scene:
+examples/thirty_balls_modal.toml (30 coal and sandstone balls, radius 10-40 mm, 3 m/s, on a
+6 x 5 grid of the default SSSS steel plate; two sensors at 51.2 kHz, 20 kHz band). Rows:
+
+- "auto": the default settings (the band, theory and mesh tailbeam.solvers.modal_setup
+  chooses);
 - "fmax N kHz": the same scene with [plate] fmax = N kHz, default steps;
-- "converged": fmax 40 kHz (30 kHz with --quick) and 400 steps per contact (default 200):
-  the truth every row is compared with. The 40 vs 30 kHz difference is its own error estimate.
-Errors: peak force, the largest relative difference over the 30 impacts (with the band's
-estimate for the worst ball, and the largest measured / estimated ratio); sensors: relative
-difference of the in-band RMS (the sampled signal's content up to the sensor bandwidth) and
-of the RMS of the whole sampled signal, worst sensor.
-Timings (wall clock, one BLAS thread): "cold" runs `tailbeam simulate` in a fresh process with
-an empty basis cache (numba's compiled code cached), "first ever" also with an empty numba cache,
-"cached" with the basis cached; the in-process rows time simulate_scene_modal with the basis
-cached (the solve time is in the basis row of the cost column).
+- "converged": fmax 40 kHz (``--quick``: 30 kHz) and 400 steps per contact (default 200),
+  the truth every row is compared with, measured in the same run.
+
+Errors: peak force, the largest relative difference over the 30 impacts (beside the band's
+own estimate for the worst ball, and the largest measured / estimated ratio); sensors: the
+relative difference of the in-band RMS (the sampled signal's content up to the sensor
+bandwidth) and of the RMS of the whole sampled signal, worst sensor. Timings (wall clock,
+one BLAS thread): ``tailbeam simulate`` in a fresh process, "first ever" with empty numba
+and basis caches, "cold" with an empty basis cache, "cached" with the basis cached; the
+in-process rows time ``simulate_scene_modal`` with the basis cached (the eigen-solve's time
+is in the basis columns).
+
 Writes DIR/bench_band.csv and DIR/table.md.
 """
 
@@ -34,12 +38,9 @@ import numpy as np
 
 from tailbeam.io.output import atomic_output_dir
 from tailbeam.io.scene_file import load_scene
-from tailbeam.solvers.modal_setup.band import (
-    _contacts,
-    describe_choices,
-    force_error_estimate,
-    simulate_scene_modal,
-)
+from tailbeam.solvers.modal_setup.band import _contacts, force_error_estimate
+from tailbeam.solvers.modal_setup.setup import describe_choices
+from tailbeam.solvers.single_ball import simulate_scene_modal
 
 SCENE = Path(__file__).resolve().parents[1] / "examples" / "thirty_balls_modal.toml"
 
@@ -190,7 +191,7 @@ def _write(out_dir, table, timings) -> Path:
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/bench_band")
+    parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--quick", action="store_true", help="converged run at 30 kHz")
     args = parser.parse_args()
     main(args.out, quick=args.quick)

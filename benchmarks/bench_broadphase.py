@@ -1,15 +1,17 @@
-"""Broad phase cost against particle count: the cell grid against brute force, same run.
+"""The stream solver's broad phase against particle count: the cell grid against brute force.
 
     python benchmarks/bench_broadphase.py --out DIR [--quick]
 
-Scene: N balls with radii uniform in 10-40 mm (the issue's reference stream), uniform in a
-cube whose side grows as N^(1/3) so that the solids fraction stays at ~8 % (the issue's
-dilute release zone), speed bounds uniform in 0-6 m/s, horizon 1 ms. For each N: the wall
-time of ``candidate_pairs`` (best of 3) and of ``candidate_pairs_brute_force`` (the O(N^2)
-reference, up to N = 16000), the number of candidate pairs, and whether both sets are
-identical (they must be: the error of the grid is 0 by construction, checked here).
-Fitted exponent: slope of log(time) against log(N) over the grid rows. Writes
-DIR/bench_broadphase.csv and DIR/table.md. Run single-threaded (OMP_NUM_THREADS=1).
+Reproduces the broad-phase row of docs/streams.md ("The parts, measured"). Scene: N balls with
+radii uniform in 10-40 mm (the reference stream's), uniform in a cube whose side grows as
+N^(1/3) so that the solids fraction stays at ~8 % (a dilute release zone), speed bounds
+uniform in 0-6 m/s, horizon 1 ms. For each N: the wall time of ``candidate_pairs`` (best of 3)
+and, the baseline in the same run, of ``candidate_pairs_brute_force`` (the O(N^2) search, up
+to N = 16000), the number of candidate pairs, and whether both sets are identical (they must
+be: the grid's error is 0 by construction, checked here). Fitted exponent: the slope of
+log(time) against log(N). ``--quick``: N up to 8000.
+
+Writes DIR/bench_broadphase.csv and DIR/table.md. Run single-threaded (OMP_NUM_THREADS=1).
 """
 
 import argparse

@@ -1,24 +1,26 @@
-"""Speed against error of the two-way coupled solver, with scipy's solve_ivp as the baseline.
+"""The two-way coupled modal solver against scipy's solve_ivp on the same modal equations.
 
     python benchmarks/bench_coupled.py --out DIR [--quick]
 
-Scene: the paper's section 4.2 pair (coal and sandstone, R = 0.03 m, 1 m/s, drop gap 0.01 m,
-x = -/+0.15 m; c, d: tailbeam.scene defaults) on the 0.6 x 0.6 x 0.01 m SSSS steel plate, exact
-Kirchhoff modes up to 10 kHz (106 modes, closed form: no FE cost), 1 % modal damping, one
-accelerometer at (0, 0.15) m sampled at 51.2 kHz (20 kHz band). One second (0.15 s with --quick).
-Both solvers integrate the same coupled modal equations (residual flexibility off, since the
-baseline cannot carry the implicit series compliance).
+Reproduces the speed figure of docs/coupled-and-sensors.md ("Speed"). Scene: the paper's
+section 4.2 pair (coal and sandstone, R = 0.03 m, 1 m/s, drop gap 0.01 m, x = -/+0.15 m; c, d:
+the tailbeam.scene defaults) on the 0.6 x 0.6 x 0.01 m SSSS steel plate, exact Kirchhoff modes
+up to 10 kHz (106 modes, closed form: no FE cost), 1 % modal damping, one accelerometer at
+(0, 0.15) m sampled at 51.2 kHz (20 kHz band); 1 s (``--quick``: 0.15 s and one baseline
+setting). Both solvers integrate the same coupled modal equations (residual flexibility off:
+the baseline cannot carry the implicit series compliance).
 
-Truth: our solver at 3200 steps per contact (its own convergence is 2nd order; the 3200 vs 1600
-difference is reported). Errors: peak force, max relative error over the first two impacts of
-each ball (later bounces on the vibrating plate are chaotic: a 1 nm change of the drop heights
-changes them by percents, reported as the "heights + 1 nm" row); sensor: relative error of the
-RMS of the sampled sensor signal over the whole record (its band is 0-20 kHz); also the waveform
-error (RMS of the difference / RMS) over the first 40 ms.
-Baseline: solve_ivp (DOP853, RK45, LSODA) on the 2 x (balls + modes) first-order ODEs with the
-IMPACT force; contact start/end as events; the force and the sensor are evaluated from the dense
-output exactly like ours. Timings: wall clock, single thread, after a warm-up (numba compiled).
-Writes DIR/bench_coupled.csv, DIR/table.md, DIR/bench_coupled.png.
+Truth: this solver at 3200 steps per contact (second order; its difference to 1600 steps is
+reported). Errors: peak force, the largest relative error over the first two impacts of each
+ball (later bounces on the vibrating plate are chaotic: a 1 nm change of the drop heights moves
+them by percents, shown as the "heights + 1 nm" row); sensor: relative error of the RMS of the
+sampled signal over the whole record, and the waveform error (RMS of the difference / RMS) over
+the first 40 ms. Baseline, in the same run: solve_ivp (DOP853, RK45) on the 2 x (balls + modes)
+first-order ODEs with the IMPACT force, contact start and end as events; force and sensor
+evaluated from its output exactly as this solver's. LSODA is left out: at rtol 1e-6 it takes
+minutes with errors like DOP853's. Timings: wall clock, single thread, after a warm-up.
+
+Writes DIR/bench_coupled.csv, DIR/table.md and DIR/bench_coupled.png.
 """
 
 import argparse
@@ -219,7 +221,6 @@ def main(out_dir, quick: bool = False):
     _, pn, sn = run_ours(basis, nudged, laws, duration, 3200)
     rows.append(["tailbeam", "3200, heights + 1 nm", float("nan"),
                  *errors(pn, sn, ref_peaks, ref_sig), ""])  # fmt: skip
-    # (LSODA rtol 1e-6 took 279 s with errors like DOP853's; left out to keep the run short)
     methods = (("DOP853", (1e-3, 1e-4, 1e-5)), ("RK45", (1e-4,)))
     if quick:
         methods = (("DOP853", (1e-5,)),)
@@ -277,9 +278,9 @@ def _plot(rows, path):
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description="coupled solver vs solve_ivp")
-    parser.add_argument("--out", default="out/bench_coupled")
-    parser.add_argument("--quick", action="store_true")
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--quick", action="store_true", help="0.15 s, one baseline setting")
     args = parser.parse_args()
     for row in main(args.out, quick=args.quick):
         print(row)

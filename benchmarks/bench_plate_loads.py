@@ -1,18 +1,20 @@
-"""Sensor signals of a stream from sparse load histories: plate_response against dense replay.
+"""Sensor signals of a stream from sparse load histories: plate_response against a dense replay.
 
     python benchmarks/bench_plate_loads.py --out DIR [--quick]
 
-Scene (the issue's stream scale): ``contacts`` ball-plate contacts at uniform random points
-of the 0.6 m plate (2 cm from the edges), random start times over ``duration``, each a
-half-sine pulse of 0.1-0.3 ms and 0.2-3 kN peak given by ``nodes`` force nodes (piecewise
-linear), plus 100 dead-load pieces (5 balls sliding in 20 pieces of 20 ms, 2-6 N; the baseline's
-short stream: one ball, pieces of duration/25); SSSS
-Kirchhoff closed-form basis to 10 kHz (106 modes), 1 % damping, 2 sensors at 51.2 kHz.
+Reproduces the cost figures of docs/streams.md ("Sensor signals"). Scene, at the reference
+stream's scale: ``contacts`` ball-plate contacts at uniform random points of the 0.6 m plate
+(2 cm from the edges), random start times over ``duration``, each a half-sine pulse of
+0.1-0.3 ms and 0.2-3 kN peak given by ``nodes`` force nodes (piecewise linear), plus 100
+dead-load pieces (5 balls sliding in 20 pieces of 20 ms, 2-6 N; the baseline's short stream:
+one ball, pieces of duration/25); SSSS Kirchhoff closed-form basis to 10 kHz (106 modes), 1 %
+damping, 2 sensors at 51.2 kHz. ``--quick``: a 1 s full case, 0.05 s baseline, 5 kHz FE basis.
 
 Rows:
 1. baseline, same run: a smaller stream (``duration`` 0.1 s, density as the full case) on
-   the sensor's fine grid (102.4 kHz) by the dense exact replay (tailbeam.solvers.plate_loads.forced:
-   one force column per contact, every node time) and by plate_response; wall time, the
+   the sensor's fine grid (102.4 kHz) by the dense exact replay
+   (tailbeam.solvers.plate_loads.forced: one force column per contact, every node time) and
+   by plate_response; wall time, the
    size of the dense force table, and their largest difference (both are exact, so it is
    rounding);
 2. the full case (6 s, 20 000 contacts) at the sensors' fine grid: plate_response wall time

@@ -1,18 +1,21 @@
-"""Benchmark of the rigid-plate solver against scipy's solve_ivp on the same scenes.
+"""The rigid-plate solver against scipy's solve_ivp: error and time against the tolerance.
 
     python benchmarks/bench_rigid.py --out DIR [--quick]
 
-Scenes (paper section 4; contact parameters: tailbeam.scene.ContactSettings defaults, plus one
-scene at c = 800 N s/m with more bounces): one ball dropped from 0.1 m gap at coal 1 m/s,
-coal 2 m/s, sandstone 1 m/s, simulated for 1 s. Truth: the reference
-(tailbeam.solvers.rigid.reference: DOP853 rtol 1e-12 restarted at every kink). Error metric: max
-relative error over every impact's peak force and every apex height. Baselines: solve_ivp
+Reproduces the speed figure of docs/rigid-solver.md ("Speed"). Scenes (paper section 4; the
+contact parameters of tailbeam.scene.ContactSettings, plus one scene at c = 800 N s/m with
+more bounces): one ball dropped from 0.1 m gap, coal at 1 m/s, coal at 2 m/s, sandstone at
+1 m/s, 1 s simulated. Truth: the rigid reference (tailbeam.solvers.rigid.reference: DOP853 at
+rtol 1e-12 restarted at every kink). Error: the largest relative error over every impact's
+peak force and every apex height reached within the run. Baseline, in the same run: solve_ivp
 (LSODA, RK45, DOP853, Radau, BDF) on the full ODE in (z, vz) with the IMPACT force, contact
-start/end as terminal events (restart there), dF/dt = 0 and vz = 0 as events for the peaks and
-apexes (located, not sampled; the force at every step point is also a peak candidate, in
-case a dF/dt root is stepped over). Apex heights compared: those reached within the run.
-Writes DIR/bench_rigid.csv, DIR/table.md and DIR/bench_rigid.png. Run single-threaded for
-reproducible timings.
+start and end as terminal events (restarted there), dF/dt = 0 and vz = 0 as events for the
+peaks and apexes (located, not sampled; the force at every step point is also a peak
+candidate, in case a dF/dt root is stepped over). Also the numba compile time of a fresh
+install. ``--quick``: one scene, two tolerances, DOP853 and LSODA (under a minute).
+
+Writes DIR/bench_rigid.csv, DIR/table.md and DIR/bench_rigid.png. Run single-threaded
+(OMP_NUM_THREADS=1) for reproducible timings.
 """
 
 import argparse
@@ -33,15 +36,11 @@ from tailbeam.io.output import atomic_output_dir
 from tailbeam.physics import impact
 from tailbeam.physics.bodies import STANDARD_GRAVITY as G
 from tailbeam.physics.contact_law import impact_force_scalar
+from tailbeam.scene import ContactSettings
 from tailbeam.solvers.rigid import simulate_rigid
 from tailbeam.solvers.rigid.reference import simulate_rigid_reference
 
-try:  # the scene defaults, if the scenes module exists
-    from tailbeam.scene import ContactSettings
-
-    CONTACT = ContactSettings()
-except ImportError:  # pragma: no cover
-    CONTACT = None
+CONTACT = ContactSettings()  # the scene defaults
 
 DURATION = 1.0
 GAP = 0.1
@@ -62,13 +61,8 @@ TIME_BUDGET = 30.0  # s: a method slower than this at some rtol is not run at ti
 def _law(material, damping=None):
     import dataclasses
 
-    from tailbeam.physics.contact_law import ball_plate_law
-
-    if CONTACT is not None:
-        contact = CONTACT if damping is None else dataclasses.replace(CONTACT, damping=damping)
-        return contact.law_for(Ball("x", material, RADIUS, (0, 0, 1)), CARBON_STEEL)
-    c = 800.0 if damping is None else damping
-    return ball_plate_law(material, RADIUS, CARBON_STEEL, damping=c, penetration=1e-4)
+    contact = CONTACT if damping is None else dataclasses.replace(CONTACT, damping=damping)
+    return contact.law_for(Ball("x", material, RADIUS, (0, 0, 1)), CARBON_STEEL)
 
 
 def _scene(material, speed, damping=None):
@@ -106,7 +100,7 @@ def run_tailbeam(ball, law, rtol, ref, repeats=5):
         res = simulate_rigid([ball], Plate(), [law], DURATION, rtol=rtol)
         best = min(best, time.perf_counter() - t0)
     peaks, apexes = _ref_lists(res)
-    return best, res.nfev, _metric(peaks, apexes, ref)
+    return best, res.stats["nfev"], _metric(peaks, apexes, ref)
 
 
 def run_solve_ivp(ball, law, method, rtol, ref):

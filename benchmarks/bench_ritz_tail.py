@@ -1,11 +1,13 @@
-"""Cost and accuracy of ``plate.tail = "ritz"`` beside the quasi-static tail (the baseline), in
-the same run, through the scene path (``simulate_scene_modal``, default 200 steps/contact).
+"""Cost and accuracy of the Ritz tail (``plate.tail = "ritz"``) beside the quasi-static tail.
 
-    python benchmarks/bench_ritz_tail.py [--out DIR] [--cases test default sweep]
+    python benchmarks/bench_ritz_tail.py --out DIR [--cases test default sweep] [--quick]
 
-Cases (each run with tail = "quasi-static" (the baseline), the default tail = "auto" (here
-the Ritz tail with tail_modes = 32) and "ritz" with tail_modes = "auto" (k chosen a
-posteriori); default and sweep also with tail_modes = 64):
+Reproduces the table of docs/fe-convergence.md ("What the Ritz tail costs"). Through the scene
+path (``simulate_scene_modal``, default 200 steps per contact), each case runs with
+``tail = "quasi-static"`` (the baseline, in the same run), the default ``tail = "auto"``
+(here the Ritz tail with tail_modes = 32) and ``"ritz"`` with ``tail_modes = "auto"`` (k
+chosen a posteriori); default and sweep also with tail_modes = 64. Cases:
+
 - test: the FE test case of tests/test_coupled_fe.py (Argyris 8x8, 20 kHz, sandstone 30 mm at
   1 m/s, no damping, 0.6 ms); truth: the full-FE reference (Newmark, 1e-7 s, ~7 s).
 - default: the same impact on the default Argyris 23x23 mesh (4805 DOFs) at 20 kHz; cost only
@@ -15,10 +17,12 @@ posteriori); default and sweep also with tail_modes = 64):
   12.8 kHz, 1 % damping); truth: the same scene at fmax 40 kHz with tail = "ritz" and
   tail_modes = "auto" (its difference to 40 kHz quasi-static is reported as the truth's own
   uncertainty).
-Reported: the Ritz pre-pass time (choose k per point + build), k, modes, the run time (best of
-3, numba warm), the first impact's contact errors (restitution, peak force, duration,
-max penetration; max of the four) and the in-band sensor error (relative L2, 0-10 kHz for
-test, 0-5 kHz for sweep). Timings on a shared machine are noisy. Writes DIR/table.md.
+
+Reported: the Ritz pre-pass time (choose k per point and build), k, modes, the run time (best
+of 3, numba warm), the first impact's contact error (restitution, peak force, duration, max
+penetration: the largest of the four) and the in-band sensor error (relative L2, 0-10 kHz for
+test, 0-5 kHz for sweep). Timings on a shared machine are noisy. ``--quick``: the test case
+only. Writes DIR/table.md.
 """
 
 import argparse
@@ -179,7 +183,7 @@ def _fmt(v, spec):
     return "-" if v is None else format(v, spec)
 
 
-def main(out_dir="out/benchmarks/bench_ritz_tail", cases=("test", "default", "sweep")):
+def main(out_dir, cases=("test", "default", "sweep")):
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
@@ -202,8 +206,9 @@ def main(out_dir="out/benchmarks/bench_ritz_tail", cases=("test", "default", "sw
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/benchmarks/bench_ritz_tail")
+    parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--cases", nargs="+", default=["test", "default", "sweep"],
                         choices=["test", "default", "sweep"])  # fmt: skip
+    parser.add_argument("--quick", action="store_true", help="the test case only")
     args = parser.parse_args()
-    main(args.out, args.cases)
+    main(args.out, ["test"] if args.quick else args.cases)

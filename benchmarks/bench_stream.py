@@ -1,31 +1,36 @@
-"""Caving streams: speed, memory and accuracy of the stream solver (issue 7's reference scene).
+"""The stream solver on the reference caving stream: speed, memory and accuracy.
 
-    python benchmarks/bench_stream.py [--out DIR] [--quick] [--convergence-only] [--top HZ]
+    python benchmarks/bench_stream.py --out DIR [--quick] [--convergence-only] [--top HZ]
+        [--particles N]
 
-The scene is ``examples/caving_stream.toml``: particles released at 200 per second from
-0.3-0.8 m above a 0.4 x 0.4 m area of a 30-degree SSSS plate, radii 10-40 mm, 30 % gangue,
-damping 300 N s/m; the stream lasts n / 200 s and the simulation 1 s longer (6 s for the
-reference scene's 1000 particles). Every case runs in its own process (``tailbeam.simulate``
-timed inside it; peak memory = the process's maximum resident set, numba and the basis
-included), after one warm-up run that fills the numba and basis caches.
+Reproduces the speed table of docs/streams.md ("Speed") and the per-impact figures of its
+"Accuracy over a stream" (first-impact peak forces against the tolerance and the band, and
+the chaos floor). The scene is ``examples/caving_stream.toml``: particles released at 200 per
+second from 0.3-0.8 m above a 0.4 x 0.4 m area of a 30-degree SSSS plate, radii 10-40 mm, 30 %
+gangue, damping 300 N s/m; the stream lasts n / 200 s and the simulation 1 s longer (6 s for
+the reference scene's 1000 particles). Every case runs ``tailbeam.simulate`` in its own
+process (timed inside it; peak memory = the process's maximum resident set, numba and the
+basis included), after one warm-up run that fills the numba and basis caches.
 
 Rows:
+
 - cost against particle count at the same rate (100, 300, 1000, 3000 particles, rigid
   plate): wall time, contacts, and the fitted exponent of time against particles;
 - the reference scene on the modal plate (band 10 kHz, basis cached, two 51.2 kHz sensors:
-  coupled both ways), as by default (the residual flexibility of the truncated modes at the
-  contacts with the contact tails: a few oscillators per contact for the modes to 40 kHz),
-  with the static residual spring alone (``plate.tail = "quasi-static"``) and without
-  residual flexibility, against the same on the rigid plate;
-- accuracy against converged runs: first-impact peak force of every particle at rtol 1e-10
-  (the default) against rtol 1e-12; on the two-way modal plate, the bands 10 and 20 kHz as
-  by default and 10 kHz with the static spring alone against the top band (``--top``,
-  default 40 kHz, static spring), and without the residual 10 against 20 kHz: first-impact
-  peak forces (median, worst) and sensor RMS (the sensors' 10 kHz band);
-  and the floor any such comparison has on a chaotic stream: the same 10 kHz run at rtol
-  1e-10 against 1e-11 (the plate's vibration when a ball lands depends on every earlier
-  impact). ``--convergence-only`` runs only the modal rows. Every case's results are kept as
-  ``DIR/<case>.json``.
+  coupled both ways) as by default (residual flexibility with the contact tails: a few
+  oscillators per contact for the modes to 40 kHz), with the static residual spring alone
+  (``plate.tail = "quasi-static"``), without residual flexibility, and at the top band
+  (``--top``, default 40 kHz, static spring), beside the rigid plate's cost;
+- accuracy, each against a converged run of the same stream measured in the same run:
+  first-impact peak forces at rtol 1e-10 (the default) against rtol 1e-12 (rigid plate); on
+  the two-way modal plate 10 and 20 kHz as by default and 10 kHz with the static spring alone
+  against the top band, and without residual flexibility 10 against 20 kHz: first-impact
+  peak forces (median, worst) and sensor RMS; and the floor any such comparison has on a
+  chaotic stream, the same 10 kHz run at rtol 1e-10 against 1e-11.
+
+``--quick``: rigid 100-1000 particles, modal rows with 200 particles (``--particles`` sets
+that count). ``--convergence-only`` runs only the modal rows. Writes DIR/table.md,
+DIR/results.json and every case's scene and results (DIR/<case>.toml, DIR/<case>.json).
 """
 
 import argparse
@@ -80,25 +85,22 @@ def run_case(path: str, rtol: float) -> dict:
     result = tailbeam.simulate(scene, rtol=rtol, progress=False)
     wall = time.perf_counter() - t0
     first, touched = {}, set()
-    for rec in sorted(result.contacts, key=lambda r: r.t_start):
+    for rec in sorted(result.impacts, key=lambda r: r.t_start):
         if rec.partner != "plate":
             touched.add(rec.ball)
         elif rec.ball not in first:
             # (peak force, start time, whether a ball-ball contact came first)
             first[rec.ball] = (rec.peak_force, rec.t_start, rec.ball in touched)
-    rms = {
-        name: float(np.sqrt(np.mean(out.acceleration**2)))
-        for name, out in (result.sensors or {}).items()
-    }
+    outputs = result.sensor_outputs
+    rms = {name: float(np.sqrt(np.mean(out.acceleration**2))) for name, out in outputs.items()}
     in_band = {
-        name: rms_below(out.t, out.acceleration, IN_BAND_HZ)
-        for name, out in (result.sensors or {}).items()
+        name: rms_below(out.t, out.acceleration, IN_BAND_HZ) for name, out in outputs.items()
     }
     return {
         "wall_s": wall,
         "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "particles": len(result.particles),
-        "contacts": len(result.contacts),
+        "contacts": len(result.impacts),
         "kernel_steps": result.stats.get("kernel_steps"),
         "first_peaks": first,
         "sensor_rms": rms,
@@ -148,6 +150,9 @@ def first_impacts(a: dict, b: dict, within: float = 1e-6) -> dict:
             if not a[k][2] and not b[k][2] and a[k][0] > 0 and b[k][0] > 0
             and abs(a[k][1] - b[k][1]) < within]  # fmt: skip
     errors = np.array([abs(a[k][0] - b[k][0]) / b[k][0] for k in same])
+    if not same:  # no particle comparable (a short stream)
+        return {"compared": 0, "particles": len(b), "worst": np.nan, "median": np.nan,
+                "within_1pct": np.nan}  # fmt: skip
     return {
         "compared": len(same),
         "particles": len(b),
@@ -157,7 +162,7 @@ def first_impacts(a: dict, b: dict, within: float = 1e-6) -> dict:
     }
 
 
-def modal_rows(out_dir: Path, top: float) -> tuple[list, dict]:
+def modal_rows(out_dir: Path, top: float, n: int = 1000) -> tuple[list, dict]:
     """The reference scene on the two-way modal plate: 10 kHz with and without residual
     flexibility (wall time, memory), and the band convergence (module docstring)."""
     runs = {}
@@ -168,12 +173,12 @@ def modal_rows(out_dir: Path, top: float) -> tuple[list, dict]:
         ("20k_off", 2e4, False, 1e-10, None),
     ):  # fmt: skip
         _in_child(out_dir, f"warm_modal_{label}", scene_text(20, "modal", fmax, residual, tail))
-        text = scene_text(1000, "modal", fmax, residual, tail)
-        runs[label] = _in_child(out_dir, f"modal_1000_{label}", text, rtol)
+        text = scene_text(n, "modal", fmax, residual, tail)
+        runs[label] = _in_child(out_dir, f"modal_{n}_{label}", text, rtol)
         print(f"modal {label}: {runs[label]['wall_s']:.2f} s", file=sys.stderr)
     rows = [
         ("modal 10 kHz, two-way, residual flexibility and contact tails (the default), "
-         "2 sensors, 1000 particles (6 s)", runs["10k"]),
+         f"2 sensors, {n} particles ({n / RATE + 1:g} s)", runs["10k"]),
         ("modal 10 kHz, two-way, residual flexibility, no contact tails (plate.tail = "
          "quasi-static), same", runs["10k_qs"]),
         ("modal 10 kHz, two-way, no residual flexibility, same", runs["10k_off"]),
@@ -249,11 +254,11 @@ def rigid_rows(out_dir: Path, quick: bool) -> tuple[list, dict]:
     return rows, {"exponent": exponent, "first_impacts": peaks, "text": text}
 
 
-def main(out_dir="out/bench_stream", quick=False, convergence_only=False, top=40000.0) -> Path:
+def main(out_dir, quick=False, convergence_only=False, top=40000.0, particles=None) -> Path:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     rows, rigid = ([], {"text": []}) if convergence_only else rigid_rows(out_dir, quick)
-    more, bands = modal_rows(out_dir, top)
+    more, bands = modal_rows(out_dir, top, particles or (200 if quick else 1000))
     lines = table_lines(rows + more) + rigid["text"] + band_lines(bands)
     table = out_dir / "table.md"
     table.write_text("\n".join(lines) + "\n")
@@ -269,9 +274,10 @@ def main(out_dir="out/bench_stream", quick=False, convergence_only=False, top=40
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/bench_stream")
-    parser.add_argument("--quick", action="store_true", help="100-1000 particles only")
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--quick", action="store_true", help="rigid 100-1000, modal 200 particles")
     parser.add_argument("--convergence-only", action="store_true", help="the modal rows only")
     parser.add_argument("--top", type=float, default=40000.0, help="top band, Hz (40000)")
+    parser.add_argument("--particles", type=int, help="particles of the modal rows (1000)")
     args = parser.parse_args()
-    main(args.out, quick=args.quick, convergence_only=args.convergence_only, top=args.top)
+    main(args.out, args.quick, args.convergence_only, args.top, args.particles)

@@ -1,31 +1,31 @@
-"""Sensor RMS of the reference caving stream at 10 kHz against 40 kHz, over an ensemble of seeds.
+"""Sensor RMS and first-impact peak forces of the reference caving stream at 10 kHz against
+40 kHz, over an ensemble of stream seeds.
 
-    python benchmarks/bench_stream_ensemble.py [--out DIR] [--seeds N] [--particles N] [--top HZ]
-                                               [--band HZ] [--tail]
+    python benchmarks/bench_stream_ensemble.py --out DIR [--seeds N] [--particles N]
+        [--top HZ] [--band HZ] [--tail] [--reuse]
 
-A stream is chaotic: two runs of one stream at different bands (or tolerances) part after a
-while, and their sensor RMS then differ by as much as two runs at one band with rtol 1e-10 and
-1e-11 (1.7e-2 on the reference scene, docs/streams.md). One run cannot tell whether the band
-changes the RMS by 1 %. An ensemble can: the reference scene (examples/caving_stream.toml,
-1000 particles, two-way modal plate with residual flexibility, two 51.2 kHz sensors) with
-stream seeds 1..N, each at the band under test (``--band``, default 10 kHz) and at the top
-band (40 kHz, where the default leaves out the contact tails); the band under test with
-``plate.tail = "quasi-static"``, or with ``--tail`` ``"ritz"`` (a few oscillators at every
-plate contact for the modes above the band, tailbeam.plate.contact_tail: the
-default below ~27 kHz); the paired relative
-difference of each sensor's RMS, its ensemble mean and standard error, and beside them the
-seed-to-seed spread of the RMS itself (what a recognition model sees from stream to stream).
-Both for the sensor output and in band (its content at or below 10 kHz, by FFT: what the
-sensor filter passes above its bandwidth left out). The same pairing for the particles'
-first-impact peak forces: each run's mean over its particles' first plate impacts (all of
-them, and those before any ball-ball contact of the particle), and the pooled distributions
-of both bands (quantiles, two-sample Kolmogorov-Smirnov test). One impact cannot be compared
-between two runs of a chaotic stream: where a particle lands, the plate vibrates from every
-earlier impact, and that history differs between any two runs (docs/streams.md). Every run
-is a child process (bench_stream.run_case), two at a time; ``--reuse`` reads a run's saved
-DIR/<run>.json instead when its scene file there is the same text (the runs are
-deterministic), to redo the comparisons. Writes DIR/ensemble.csv and DIR/table.md; the
-95 % intervals are mean +- t(0.975, seeds - 1) x standard error.
+Reproduces the ensemble table of docs/streams.md ("Accuracy over a stream"; there with
+``--seeds 32 --tail``, about 35 min on an idle 2-core machine). A stream is chaotic: two
+runs of one stream at different bands (or tolerances) part after a while, and their sensor
+RMS then differ by as much as two runs at one band with rtol 1e-10 and 1e-11. One run cannot
+tell whether the band changes the RMS by 1 %; an ensemble can. The reference scene
+(examples/caving_stream.toml, ``--particles`` particles (1000), two-way modal plate with
+residual flexibility, two 51.2 kHz sensors) with stream seeds 1..N, each at the band under
+test (``--band``, default 10 kHz; with ``plate.tail = "quasi-static"``, or with ``--tail``
+the contact tails, ``"ritz"``) and at the top band (``--top``, 40 kHz: the baseline, measured
+in the same run). Reported per quantity: the paired relative difference (band under test
+against top band, paired by seed), its ensemble mean, standard error and 95 % interval
+(mean +- t(0.975, seeds - 1) x standard error), and beside them the seed-to-seed spread of
+the quantity itself (what a recognition model sees from stream to stream). Quantities: each
+sensor's RMS, of the sensor output and in band (its content at or below 10 kHz, by FFT), and
+each run's mean first-impact peak force (all first plate impacts, and those before any
+ball-ball contact of the particle), with the pooled distributions of both bands (quantile
+ratios, two-sample Kolmogorov-Smirnov test). Every run is a child process
+(``bench_stream.run_case``), two at a time; ``--reuse`` reads a run's saved DIR/<run>.json
+instead when its scene file there is the same text (the runs are deterministic), to redo the
+comparisons. A short check: ``--seeds 2 --particles 100 --top 20000``.
+
+Writes DIR/ensemble.csv and DIR/table.md.
 """
 
 import argparse
@@ -176,7 +176,7 @@ def write(rows, out_dir: Path, top: float, notes=(), band: float = 1e4) -> None:
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/bench_stream_ensemble")
+    ap.add_argument("--out", required=True, help="output folder")
     ap.add_argument("--seeds", type=int, default=6)
     ap.add_argument("--particles", type=int, default=1000)
     ap.add_argument("--top", type=float, default=40000.0)

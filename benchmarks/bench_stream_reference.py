@@ -1,17 +1,21 @@
 """Convergence and cost of the slow stream reference against its tolerance.
 
-    python benchmarks/bench_stream_reference.py [--quick]
+    python benchmarks/bench_stream_reference.py --out DIR [--quick]
 
-Scene: the ten-ball scene of the tests (tests/stream_scenes.py: a 3-ball cluster, a ball
-resting on the 15 degree plate hit by another, two mid-air collisions, one free fall),
-c = 2000 N s/m, d = 2e-5 m, 0.1 s. Truth: the same reference at rtol 1e-13. For rtol 1e-7 ..
-1e-12: wall time, steps, and the largest relative error over every contact's peak force,
-v_out (relative to max(|v_out|, approach speed): a ball left at rest has v_out ~ 0) and
-duration, with the contacts matched by (ball, partner, n-th contact of that pair). The
-measured order is the slope of log(error) against log(rtol).
+Reproduces the convergence figures of docs/streams.md ("The slow reference"). Scene: the
+ten-ball scene of the tests (tests/stream_scenes.py: a 3-ball cluster, a ball resting on the
+15 degree plate hit by another, two mid-air collisions, one free fall), c = 2000 N s/m,
+d = 2e-5 m, 0.1 s (``--quick``: 0.06 s). Truth: the same reference at rtol 1e-13, in the same
+run. For rtol 1e-7 ... 1e-12: wall time, steps, and the largest relative error over every
+contact's peak force, v_out (relative to max(|v_out|, approach speed): a ball left at rest has
+v_out ~ 0) and duration, with the contacts matched by (ball, partner, n-th contact of that
+pair). The measured order is the slope of log(error) against log(rtol).
+
+Writes DIR/bench_stream_reference.csv and DIR/table.md.
 """
 
 import argparse
+import csv
 import sys
 import time
 from pathlib import Path
@@ -58,26 +62,41 @@ def error(res, truth):
     return worst
 
 
-def main(quick=False):
+def main(out_dir, quick=False):
     duration = 0.06 if quick else 0.1
     truth, t_truth = run(1e-13, duration)
     print(f"truth rtol 1e-13: {t_truth:.1f} s, {truth.steps} steps, "
-          f"{len(truth.contacts)} contact records")  # fmt: skip
-    print("| rtol | wall (s) | steps | max rel. error |\n|---|---|---|---|")
-    rtols, errors = [], []
+          f"{len(truth.contacts)} contact records", flush=True)  # fmt: skip
+    rows = []
     for rtol in (1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12):
         res, wall = run(rtol, duration)
-        err = error(res, truth)
-        rtols.append(rtol)
-        errors.append(err)
-        print(f"| {rtol:g} | {wall:.2f} | {res.steps} | {err:.2e} |", flush=True)
-    ok = [(r, e) for r, e in zip(rtols, errors, strict=True) if np.isfinite(e) and e > 0]
+        rows.append({"rtol": rtol, "wall_s": wall, "steps": res.steps,
+                     "max_rel_error": error(res, truth)})  # fmt: skip
+        print(rows[-1], flush=True)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "bench_stream_reference.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    lines = [f"Ten-ball scene, {duration:g} s; truth: rtol 1e-13 ({truth.steps} steps, "
+             f"{t_truth:.1f} s, {len(truth.contacts)} contact records).", "",
+             "| rtol | wall (s) | steps | max rel. error |", "|---|---|---|---|"]  # fmt: skip
+    for r in rows:
+        lines.append(f"| {r['rtol']:g} | {r['wall_s']:.2f} | {r['steps']} | "
+                     f"{r['max_rel_error']:.2e} |")  # fmt: skip
+    ok = [(r["rtol"], r["max_rel_error"]) for r in rows
+          if np.isfinite(r["max_rel_error"]) and r["max_rel_error"] > 0]  # fmt: skip
     if len(ok) >= 2:
         slope = np.polyfit(np.log([r for r, _ in ok]), np.log([e for _, e in ok]), 1)[0]
-        print(f"\nmeasured order: error ~ rtol^{slope:.2f}")
+        lines.append(f"\nMeasured order: error ~ rtol^{slope:.2f}")
+    (out / "table.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--quick", action="store_true", help="0.06 s instead of 0.1 s")
-    main(parser.parse_args().quick)
+    args = parser.parse_args()
+    main(args.out, args.quick)

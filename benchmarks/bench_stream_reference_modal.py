@@ -1,27 +1,28 @@
-"""The fast stream solver on the two-way modal plate against the slow reference (issue 7).
+"""The fast stream solver on the two-way modal plate against the slow reference.
 
     python benchmarks/bench_stream_reference_modal.py --out DIR [--quick]
 
-Scenes: ``modal_scene`` of tests/stream_scenes.py (seven balls: a 3-ball cluster, a stacked
-pair, oblique landings on the vibrating plate), 30 ms, on the closed-form SSSS Kirchhoff
-modes below FMAX (1300 Hz: 11 modes; without --quick also 2600 Hz: 24 and 10 kHz: 106,
-the default band of the stream scenes), modal damping 1 %:
+Reproduces the "mode shapes kept through a contact" figures of docs/streams.md ("What is
+approximated, and by how much"). Scenes: ``modal_scene`` of tests/stream_scenes.py (seven
+balls: a 3-ball cluster, a stacked pair, oblique landings on the vibrating plate), 30 ms, on
+the closed-form SSSS Kirchhoff modes below 1300 Hz (11 modes), 2600 Hz (24) and 10 kHz (106,
+the default band of the stream scenes; ``--quick``: 1300 Hz only), modal damping 1 %:
 horizontal with c = 0, and 15 degrees with c = 2000 N s/m, d = 2e-5 m (ramp, clamp).
 
-For each: the slow reference (tailbeam.solvers.stream.reference.solver) with exact mode shapes and
-with frozen ones (a contact keeps the shapes of its first touch: the fast solver's model) at
-rtol 1e-12, and the frozen one at 1e-13 (the reference's own error); the fast solver
-(rtol 1e-12, no residual flexibility, no rest rules) at its defaults (shapes refreshed
-every SHAPE_TRAVEL = 1 mm of lateral travel, reused within SHAPE_REUSE = 0.25 mm) and with
-both distances set to 1e-4, 1e-5, 1e-6 m (module constants of the fast solver, changed here
-for this study only). Measure: the worst relative difference over every ContactRecord field
-(tests/test_stream_solver.py: times on 1 ms, speeds and positions on 1 m/s and 1 m, peak
-force and penetration relative), and the same over the impacts only (contacts whose peak
-force is at least GRAZE = 1 % of the largest: a graze's relative peak force is
-ill-conditioned). Speed: the wall times, the reference's as the baseline.
+Baseline, in the same run: the slow reference (tailbeam.solvers.stream.reference) with exact
+mode shapes and with frozen ones (a contact keeps the shapes of its first touch: the fast
+solver's model) at rtol 1e-12, and the frozen one at 1e-13 (the reference's own error).
+Against them the fast solver (rtol 1e-12, no residual flexibility, no rest rules) at its
+defaults (shapes refreshed every SHAPE_TRAVEL = 1 mm of lateral travel, reused within
+SHAPE_REUSE = 0.25 mm) and with both distances set to 1e-4, 1e-5 and 1e-6 m (module
+constants of the fast solver, changed here for this study only). Measure: the worst relative
+difference over every contact record's fields (tests/test_stream_solver.py: times on 1 ms,
+speeds and positions on 1 m/s and 1 m, peak force and penetration relative), and the same
+over the impacts only (contacts whose peak force is at least GRAZE = 1 % of the largest: a
+graze's relative peak force is ill-conditioned); the wall times.
 
-Writes DIR/bench_stream_reference_modal.csv, DIR/table.md, DIR/refresh.png. Run
-single-threaded (OMP_NUM_THREADS=1). The first fast run compiles the kernels (warm-up, not
+Writes DIR/bench_stream_reference_modal.csv, DIR/table.md and DIR/refresh.png. Run
+single-threaded (OMP_NUM_THREADS=1). The first fast run compiles the kernels (a warm-up, not
 kept).
 """
 
@@ -40,7 +41,7 @@ from test_stream_solver import _particles, _worst_difference  # noqa: E402
 
 from tailbeam.physics.bodies import Plate  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
-from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis  # noqa: E402
 from tailbeam.solvers.stream.active import shapes as active_shapes  # noqa: E402
 from tailbeam.solvers.stream.driver import loop as stream  # noqa: E402
 from tailbeam.solvers.stream.driver import membership as stream_membership  # noqa: E402
@@ -187,7 +188,7 @@ def write(rows, out):
     (out / "table.md").write_text("\n".join(lines) + "\n")
 
 
-def main(out_dir="out/bench_stream_reference_modal", quick: bool = False):
+def main(out_dir, quick: bool = False):
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     bands = (1300.0,) if quick else (1300.0, 2600.0, 10000.0)
@@ -202,7 +203,7 @@ def main(out_dir="out/bench_stream_reference_modal", quick: bool = False):
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/bench_stream_reference_modal")
+    parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--quick", action="store_true", help="only the 1300 Hz band")
     args = parser.parse_args()
     main(args.out, quick=args.quick)

@@ -1,29 +1,35 @@
-"""Benchmark of `tailbeam sweep`: throughput on 1 and 2 Dask workers beside a plain loop,
-the share of dataset writing, and worker memory.
+"""`tailbeam sweep` on 1 and 2 Dask workers against plain processes: throughput, the share of
+dataset writing, and worker memory.
 
-    python benchmarks/bench_sweep.py [--out DIR] [--quick] [--cases N] [--set KEY=VALUE ...]
+    python benchmarks/bench_sweep.py --out DIR [--quick] [--cases N] [--tail quasi-static]
+        [--set KEY=VALUE ...]
 
-The sweep: N single impacts (default 200; half coal, half sandstone; radius log-uniform
-10-100 mm, 1-5 m/s, anywhere over |x|, |y| <= 0.25 m) on the SSSS modal plate (modes to 5 kHz,
-basis cached before timing), one sensor at 12.8 kHz, 25 ms each. Runs, on the same cases:
-1. baseline: the cases in a plain loop in this process (run_case, no Dask, no writing);
-   then the same cases split over 1 and over 2 plain loops in fresh processes started
-   together (one BLAS thread each, as Dask's workers): the 2-process speed-up is what this
-   machine gives the work in parallel, the ceiling of the sweep's (shared caches and memory
-   bandwidth: measured 1.81 for the quasi-static cases, 1.94 for the default Ritz tail);
+Reproduces the speed table of docs/datasets.md ("Speed"). The sweep: N single impacts
+(default 200, ``--quick`` 20; half coal, half sandstone; radius log-uniform 10-100 mm,
+1-5 m/s, anywhere over |x|, |y| <= 0.25 m) on the SSSS modal plate (modes to 5 kHz, basis
+cached before timing), one sensor at 12.8 kHz, 25 ms each. Runs, on the same cases:
+
+1. the baseline, in the same run: the cases in a plain loop in this process (run_case, no
+   Dask, no writing); then the same cases split over 1 and over 2 plain loops in fresh
+   processes started together (one BLAS thread each, as Dask's workers): the 2-process
+   speed-up is what this machine gives the work in parallel, the ceiling of the sweep's
+   (shared caches and memory bandwidth);
 2. the sweep on a LocalCluster of 1 worker, then of 2 workers (fresh dataset folder each;
    workers started and warmed before the clock starts).
+
 ``--tail quasi-static`` runs the cases with the quasi-static tail instead of the default
-(``plate.tail = "auto"``: the Ritz tail, 32 pseudo-modes per case).
-Reports cases/s, speed-up over 1 worker, time spent writing the dataset (Zarr + Parquet + CSV)
-as a share of the summed case compute time and of the sweep's wall time, the CPU time of the
-client process (the client, the in-process scheduler and the nannies) per case, and each
-worker's peak resident memory. The client imports its writing libraries (xarray, zarr,
-pyarrow) before the clocks start, as it does the workers: a one-off ~0.3 s per process that
-would otherwise be charged to whichever run writes first. Writes DIR/bench_sweep.csv and
-DIR/table.md. Timings on a shared machine are noisy: run it 2-3 times. ``--set`` changes a Dask
-setting for both clusters (e.g. ``--set distributed.scheduler.worker-saturation=inf``), to
-measure a choice of ``tailbeam.study.sweep.SCHEDULER_CONFIG`` against the shipped one.
+(``plate.tail = "auto"``: the Ritz tail, 32 pseudo-modes per case). Reports cases/s, the
+speed-up over 1 worker, the time spent writing the dataset (Zarr + Parquet + CSV) as a share
+of the summed case compute time and of the sweep's wall time, the CPU time of the client
+process (the client, the in-process scheduler and the nannies) per case, and each worker's
+peak resident memory. The client imports its writing libraries (xarray, zarr, pyarrow) before
+the clocks start, as it does the workers: a one-off ~0.3 s per process that would otherwise
+be charged to whichever run writes first. Timings on a shared machine are noisy: run it 2-3
+times. ``--set`` changes a Dask setting for both clusters (e.g.
+``--set distributed.scheduler.worker-saturation=inf``), to measure a choice of
+``tailbeam.study.sweep.SCHEDULER_CONFIG`` against the shipped one.
+
+Writes DIR/bench_sweep.csv, DIR/table.md and the two datasets (DIR/dataset_1w, DIR/dataset_2w).
 """
 
 import argparse
@@ -261,7 +267,7 @@ def _table(rows, path: Path, n: int) -> None:
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/benchmarks/bench_sweep")
+    parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--quick", action="store_true", help="20 cases")
     parser.add_argument("--cases", type=int, default=None)
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")

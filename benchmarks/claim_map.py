@@ -1,15 +1,18 @@
-"""Fragility map of the paper's claims over the unknown contact settings (c, d) and drop gap.
+"""Which of the paper's claims hold over a grid of the contact settings it does not give.
 
-The paper gives no damping c, penetration depth d or drop height. This study runs the three
-scenarios (sections 4.1-4.3) at every point of a grid of (c, d, drop gap) and records which
-claims hold (tailbeam.paper.claims). Outputs in --out DIR:
-  claim_map.csv  one row per grid point: c, d, gap, number of claims holding, 0/1 per claim
-  table.csv      per claim: fraction of the grid where it holds, and of the defaults'
-                 neighbourhood (c within x/÷1.5, d within x/÷2, gap <= 10 mm)
-  table.md       the same as a markdown table
-  claim_map.png  one panel per drop gap: number of claims holding over (c, d)
+    python benchmarks/claim_map.py --out DIR [--quick]
 
-    python benchmarks/claim_map.py --out out/claim_map [--quick]
+Reproduces the figure of docs/reproduction.md ("How fragile the claims are"). The paper gives
+no damping c, penetration depth d or drop height. This study runs the three scenarios
+(sections 4.1-4.3) at every point of a grid of (c, d, drop gap) and records which claims hold
+(tailbeam.paper.claims); the defaults (tailbeam.scene) are grid points, the baseline the
+others are read against. ``--quick``: a coarse grid (seconds). Writes to DIR:
+
+- claim_map.csv: one row per grid point: c, d, gap, number of claims holding, 0/1 per claim;
+- table.csv: per claim, the fraction of the grid where it holds, and of the defaults'
+  neighbourhood (c within x/÷1.5, d within x/÷2, gap <= 10 mm);
+- table.md: the same as a markdown table;
+- claim_map.png: one panel per drop gap, the number of claims holding over (c, d).
 """
 
 import argparse
@@ -120,7 +123,7 @@ def main(out_dir, quick=False):
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/claim_map")
-    parser.add_argument("--quick", action="store_true", help="small grid, < 60 s")
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--quick", action="store_true", help="a coarse grid, seconds")
     args = parser.parse_args()
     main(args.out, quick=args.quick)

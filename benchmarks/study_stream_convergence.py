@@ -1,30 +1,34 @@
-"""Convergence of a many-ball two-way run on the modal plate, with the tolerance and the band.
+"""Convergence of many-ball two-way runs on the modal plate with the tolerance and the band.
 
-    python benchmarks/study_stream_convergence.py [--out DIR] [--quick]
+    python benchmarks/study_stream_convergence.py --out DIR [--quick]
 
-Scenes: the ten-ball scene of the tests (ball-ball contacts in flight, a 3-ball cluster, a
-stacked pair; tests/stream_scenes.py) on a horizontal and on a 20-degree plate, and a generated
-stream of ~40 particles on the 20-degree plate (c = 300 N s/m). Plate: the closed-form SSSS
-Kirchhoff basis of the default 0.6 x 0.6 x 0.01 m steel plate (exact modes at any band, so
-the band study has no mesh error), 1 % modal damping, two-way coupling through the fast stream
-solver (``tailbeam.solvers.stream.driver.loop.solve_stream`` with a ``StreamPlate``).
+Reproduces the table of docs/streams.md ("Convergence with tolerance and band"). Scenes: the
+ten-ball scene of the tests (ball-ball contacts in flight, a 3-ball cluster, a stacked pair;
+tests/stream_scenes.py) on a horizontal and on a 20-degree plate, and a generated stream of
+~40 particles on the 20-degree plate (c = 300 N s/m; ``--quick``: the two ten-ball scenes,
+fewer settings, truth band 20 kHz). Plate: the closed-form SSSS Kirchhoff basis of the default
+0.6 x 0.6 x 0.01 m steel plate (exact modes at any band, so the band study has no mesh
+error), 1 % modal damping, two-way coupling through the fast stream solver
+(``tailbeam.solvers.stream.driver.loop.solve_stream`` with a ``StreamPlate``).
 
-1. Tolerance: rtol 1e-6 ... 1e-11 against rtol 1e-13, band fixed.
-2. Band: 2.5, 5, 10, 20 kHz against 40 kHz, rtol 1e-12, with the residual flexibility of the
+1. Tolerance: rtol 1e-6 ... 1e-11 against rtol 1e-13 (band 5 kHz).
+2. Band: 2.5, 5, 10, 20 kHz against 40 kHz (rtol 1e-12), with the residual flexibility of the
    truncated modes at the contacts (the default) and without it.
 
-A stream is chaotic (docs/streams.md): a change of tolerance or band can change which balls
-meet, and then everything after. So each run's contact records (ball, partner, in order of
-start) are compared with the truth's over their common prefix only, and the table gives that
-prefix's length. Errors: over each ball's FIRST impact (its first contact
-that ends separated, approaching faster than 0.1 m/s: the chatter of balls
-settling on the plate or on each other is not an impact), where both runs have the same one,
-the largest relative difference of the duration, the peak force and the separation speed
-(approach_out, relative to the approach speed). Later impacts of a ball that bounces in a
-stacked pair on the vibrating plate diverge exponentially with the contact count (measured:
-1e-10 on the first impacts, 1e-2 after ten bounces of the pair at rtol 1e-10 against 1e-13),
-which is the chaos, not the solver's error. Writes DIR/convergence.csv,
-DIR/table.md and DIR/convergence.png; prints the fitted orders (log-log slope).
+Each truth is run in the same run. A stream is chaotic (docs/streams.md): a change of
+tolerance or band can change which balls meet, and then everything after. So each run's
+contact records (ball, partner, in order of start) are compared with the truth's over their
+common prefix only, and the table gives that prefix's length. Errors: over each ball's first
+impact (its first contact that ends separated, approaching faster than 0.1 m/s: the chatter
+of balls settling on the plate or on each other is not an impact), where both runs have the
+same one, the largest relative difference of the duration, the peak force and the separation
+speed (approach_out, relative to the approach speed). Later impacts of a ball that bounces in
+a stacked pair on the vibrating plate diverge exponentially with the contact count (1e-10 on
+the first impacts, 1e-2 after ten bounces of the pair at rtol 1e-10 against 1e-13): the
+chaos, not the solver's error.
+
+Writes DIR/convergence.csv, DIR/table.md and DIR/convergence.png; prints the fitted orders
+(log-log slopes).
 """
 
 import argparse
@@ -41,7 +45,7 @@ from stream_scenes import first_impact_difference, ten_ball_scene  # noqa: E402
 
 from tailbeam.physics.bodies import Plate  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
-from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
+from tailbeam.plate.closed_forms import ssss_kirchhoff_basis  # noqa: E402
 from tailbeam.solvers.stream.driver.loop import solve_stream  # noqa: E402
 from tailbeam.solvers.stream.plate import StreamPlate  # noqa: E402
 from tailbeam.streams.generator import Particle, generate_particles  # noqa: E402
@@ -177,7 +181,7 @@ def _plot(rows, path: Path) -> None:
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/study_stream_convergence")
+    ap.add_argument("--out", required=True, help="output folder")
     ap.add_argument("--quick", action="store_true", help="fewer settings, the two ten-ball scenes")
     args = ap.parse_args()
     write(study(args.quick), Path(args.out))

@@ -1,13 +1,25 @@
-"""Whether two sweep output folders hold the same dataset (a speed change's check).
+"""Whether two sweep output folders hold the same dataset.
 
-    python benchmarks/compare_sweep_datasets.py DIR_A DIR_B
+    python tools/compare_sweep_datasets.py DIR_A DIR_B
 
 Compares ``dataset.zarr`` (signals, coordinates, attributes: ``xarray.testing.assert_identical``),
 ``impacts.parquet`` and ``cases.csv`` (exactly), after ordering the cases by their hash and
 leaving out what a run may change: the case ids (they follow completion order) and the
-timings (``wall_time``, ``cpu_time``). Within a case, impact rows keep their order. E.g. the
-datasets ``bench_sweep.py --out DIR`` writes (DIR/dataset_1w, DIR/dataset_2w) of two revisions.
-Prints "identical" and the sizes, or the first difference (exit code 1).
+timings (``wall_time``, ``cpu_time``). Within a case, impact rows keep their order. Prints
+"identical" and the sizes, or the first difference (exit code 1).
+
+Two revisions' sweeps of one sweep file, with one modal cache so that both read the same
+basis file (a basis computed again differs at rounding level), the base's from outside the
+work tree (Python puts the current folder first on its path)::
+
+    mkdir /tmp/base && git archive REV | tar -x -C /tmp/base
+    export TAILBEAM_CACHE_DIR=/tmp/sweep-cache SWEEP=$PWD/examples/sweeps/single_impacts.toml
+    (cd /tmp && PYTHONPATH=/tmp/base python -m tailbeam sweep $SWEEP --out /tmp/sweep-base)
+    python -m tailbeam sweep $SWEEP --out /tmp/sweep-this
+    python tools/compare_sweep_datasets.py /tmp/sweep-base /tmp/sweep-this
+
+Or the two datasets ``benchmarks/bench_sweep.py --out DIR`` writes (DIR/dataset_1w and
+DIR/dataset_2w: one sweep on 1 and on 2 workers).
 """
 
 import argparse

@@ -1,34 +1,34 @@
-"""CPU time of the compiled solvers in this tree against another revision, interleaved.
+"""CPU time of the compiled solvers in this tree against another revision's, interleaved.
 
-    python benchmarks/time_revisions.py --base REV [--rounds 3] [--solver NAME]
+    python tools/time_revisions.py --base REV [--rounds 3] [--solver NAME]
 
-Scenes. ``rigid`` (the default): ten coal balls (30 mm, dropped from 0.10-0.19 m gap at
-1.0-1.9 m/s, c = 800 N s/m), 1 s, rtol 1e-10 (~61 000 right-hand-side evaluations of the law
-in the kernel), 40 runs (nfev printed). ``coupled``: the two-way coupled modal solver,
-sandstone at 2 m/s on the closed-form SSSS plate (5 kHz band, c = 800 N s/m), 2 ms, 10 runs
-(force nodes printed). ``stream``: the fast stream solver on the ten-ball scene of the tests
-(15 deg plate, c = 2000 N s/m, d = 2e-5 m, rtol 1e-12, 0.1 s), 10 runs (kernel steps printed).
-``active_set``: the compiled active set alone, CPU time per step of 2 ms of simulated time of
-8 resting balls with their neighbour pairs and of 16 with all pairs (``bench_active_set``'s
-``resting_set``), 10 runs each.
+``--solver`` picks the scene:
 
-Each tree runs in its own process with its own numba cache (compiled and run once first, not
-timed), then the timed runs with ``time.process_time`` (CPU time: less sensitive than the
-wall clock to other processes on a shared machine); prints best and median per tree and
-round, and the wall time of the first call (numba compiles then: round 1 only, the cache
-is warm in later rounds). The trees alternate, so a change of machine load hits both. Same
-work in both trees is checked by the count printed.
+- ``rigid`` (the default): ten coal balls (30 mm, dropped from 0.10-0.19 m gap at
+  1.0-1.9 m/s, c = 800 N s/m) on the rigid plate, 1 s, rtol 1e-10, 40 timed runs; prints the
+  right-hand-side evaluations (nfev, about 61 000).
+- ``coupled``: the two-way coupled modal solver, sandstone at 2 m/s on the closed-form SSSS
+  plate (5 kHz band, c = 800 N s/m), 2 ms, 10 runs; prints the force nodes.
+- ``stream``: the fast stream solver on the ten-ball scene of the tests (15 deg plate,
+  c = 2000 N s/m, d = 2e-5 m, rtol 1e-12, 0.1 s), 10 runs; prints contacts and kernel steps.
+- ``active_set``: the compiled active set alone, CPU time per step over 2 ms of simulated
+  time of 8 coal balls resting on a 15 deg plate with their neighbour pairs and of 16 with
+  all pairs (``resting_set``, as ``benchmarks/bench_active_set.py`` measures), 10 runs each;
+  prints the steps.
+
+Each tree runs in its own process with its own numba cache: the scene once (timed on the wall
+clock: numba compiles in round 1, the cache is warm in later rounds), then the timed runs in
+CPU time (``time.process_time``: less sensitive than the wall clock to other processes on a
+shared machine). Prints best and median per tree and round. The trees alternate, so a change
+of machine load hits both; the count printed checks that both trees did the same work.
 """
 
 import argparse
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
-from compare_active_set_revisions import extract_revision, from_either
+from revisions import ROOT, extract_revision, from_either, run_in
 
-ROOT = Path(__file__).resolve().parents[1]
 REPEATS = 40
 
 
@@ -60,7 +60,7 @@ def time_rigid(label):
     balls = [Ball(f"b{i}", COAL, 0.03, (-0.2 + 0.04 * i, 0.0, 0.13 + 0.01 * i),
                   (0.0, 0.0, -1.0 - 0.1 * i)) for i in range(10)]  # fmt: skip
     _timed(label, lambda: simulate_rigid(balls, Plate(), [law] * 10, 1.0, rtol=1e-10), REPEATS,
-           lambda r: f"{r.nfev if hasattr(r, 'nfev') else r.stats['nfev']} nfev")  # fmt: skip
+           lambda r: f"{r.stats['nfev'] if hasattr(r, 'stats') else r.nfev} nfev")  # fmt: skip
 
 
 def time_coupled(label):
@@ -78,16 +78,21 @@ def time_coupled(label):
     ball = Ball("s", SANDSTONE, 0.03, (0.07, -0.05, 0.03 + 1e-4), (0.0, 0.0, -2.0))
     law = ball_plate_law(SANDSTONE, 0.03, CARBON_STEEL, damping=800.0)
     _timed(label, lambda: simulate_coupled([ball], basis, [law], 2e-3, gravity=9.80665), 10,
-           lambda r: f"{len((r.nodes if hasattr(r, 'nodes') else r.plate.nodes)[0])} nodes")  # fmt: skip
+           lambda r: f"{len(_nodes(r)[0])} nodes")  # fmt: skip
+
+
+def _nodes(result):
+    """The coupled solver's force nodes: on the result's plate part, or on the result itself
+    in a revision without one."""
+    return result.plate.nodes if getattr(result, "plate", None) is not None else result.nodes
 
 
 def time_stream(label):
     """Run and time the stream scene (see the module's docstring); print one line."""
     import stream_scenes
 
-    from tailbeam.physics.incline import InclinedPlate
-    from tailbeam.streams.generator import Particle
-
+    InclinedPlate = from_either("InclinedPlate", "tailbeam.physics.incline")
+    Particle = from_either("Particle", "tailbeam.streams.generator")
     solve_stream = from_either(
         "solve_stream",
         "tailbeam.solvers.stream.driver.loop",
@@ -111,18 +116,45 @@ def time_stream(label):
     )
 
 
+def resting_set(n, all_pairs):
+    """An active set of n coal balls (30 mm) at rest on a 15 deg plate (static penetration,
+    vz = -0.1 mm/s so that the contacts work), on an 8 x 8 grid 70 mm apart (no two touch);
+    pairs: the plate pairs and the neighbours in grid order, or all ball-ball pairs."""
+    import math
+
+    from tailbeam import CARBON_STEEL, COAL, Ball, ball_plate_law
+
+    InclinedPlate = from_either("InclinedPlate", "tailbeam.physics.incline")
+    ActiveSet = from_either(
+        "ActiveSet", "tailbeam.solvers.stream.active.set", "tailbeam.solvers.stream.active_set"
+    )
+    radius = 0.03
+    incline = InclinedPlate(inclination=15.0)
+    law = ball_plate_law(COAL, radius, CARBON_STEEL)
+    gn = incline.gravity * math.cos(math.radians(15.0))
+    z = radius - law.static_penetration(Ball("p", COAL, radius, (0, 0, 1.0)).mass * gn)
+    balls, pairs = [], []
+    for b in range(n):
+        x, y = -0.245 + 0.07 * (b % 8), -0.245 + 0.07 * (b // 8)
+        balls.append(Ball(f"b{b}", COAL, radius, (x, y, z), (0.0, 0.0, -1e-4)))
+        pairs.append((b, -1))
+    for i in range(n):
+        for j in range(i + 1, n if all_pairs else min(i + 2, n)):
+            pairs.append((i, j))
+    return ActiveSet.from_balls(balls, pairs, incline, rtol=1e-10)
+
+
 def time_active_set(label):
-    """Time the active set's steps alone (see the module's docstring); print one line."""
+    """Time the active set's steps alone (see the module's docstring); print one line per set."""
     import time
 
     import numpy as np
-    from bench_active_set import resting_set
 
     for n, all_pairs in ((8, False), (16, True)):
-        resting_set(n, all_pairs)[0].advance(0.0, 1e-4)  # compile
+        resting_set(n, all_pairs).advance(0.0, 1e-4)  # compile
         cpu = []
         for _ in range(10):
-            s = resting_set(n, all_pairs)[0]
+            s = resting_set(n, all_pairs)
             t0 = time.process_time()
             s.advance(0.0, 2e-3)
             cpu.append((time.process_time() - t0) / s.stats["steps"])
@@ -131,27 +163,14 @@ def time_active_set(label):
               f"median {np.median(cpu) * 1e6:.2f} us", flush=True)  # fmt: skip
 
 
-def _run_in(tree, cache, label, solver):
-    code = (f"import sys; sys.path[:0] = [{str(tree)!r}, {str(tree / 'tests')!r}, "
-            f"{str(ROOT / 'benchmarks')!r}]; "
-            f"import time_revisions as t; t.time_{solver}({label!r})")  # fmt: skip
-    env = {
-        "TAILBEAM_CACHE_DIR": str(cache),
-        "NUMBA_CACHE_DIR": str(cache / "numba"),
-        "OMP_NUM_THREADS": "1",
-        "OPENBLAS_NUM_THREADS": "1",
-        "PATH": "/usr/bin:/bin",
-    }
-    subprocess.run([sys.executable, "-c", code], check=True, cwd=tree, env=env)
-
-
 def main(base, rounds, solver="rigid"):
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         old = extract_revision(base, tmp)
         for r in range(rounds):
-            _run_in(old, tmp / "cache-base", f"{solver} round {r + 1}, {base}", solver)
-            _run_in(ROOT, tmp / "cache-new", f"{solver} round {r + 1}, this tree", solver)
+            for tree, name, cache in ((old, base, "cache-base"), (ROOT, "this tree", "cache-new")):
+                label = f"{solver} round {r + 1}, {name}"
+                run_in(tree, tmp / cache, f"time_revisions.time_{solver}({label!r})")
 
 
 if __name__ == "__main__":

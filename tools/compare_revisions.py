@@ -1,52 +1,51 @@
-"""How far every solver's results moved from another revision's (a refactor's check).
+"""How far every solver's results in this tree are from another revision's.
 
-    python benchmarks/compare_revisions.py --base REV [--quick]
+    python tools/compare_revisions.py --base REV [--quick] [--keep DIR]
 
-Runs one scene per solver in this working tree and in ``git archive REV`` (each with its own
-numba cache, single-threaded) and compares every number they report: the rigid solver and
-its scipy reference (paper section 4.1: coal balls at 1 and 2 m/s, c = 800 N s/m, 1 s), the
-two-way coupled modal solver (sandstone at 2 m/s on the closed-form SSSS plate, 5 kHz band,
-c = 800 N s/m, residual flexibility on) and the FE reference (the same ball on Argyris 8x8,
-dt 2e-7 s, 0.4 ms), the stream solver and the stream reference (the ten-ball scene on a
-15 deg plate, c = 2000 N s/m, d = 2e-5 m: ball-ball contacts, clamp and STEP kinks), the stream
-solver on the modal plate. Prints per solver "bit-identical" or the largest difference of
-any number relative to the largest magnitude of its column (and the column), the numeric
-columns whose length changed (an adaptive reference taking other steps), the non-numeric
-columns (names, event kinds, ends) that differ, and the columns only this tree has (a record
-extended: compared are the base's columns, each of which must still exist). Records are
-flattened by ``as_dict()`` when they have it (so derived values such as ``restitution``
-are compared), else by their dataclass fields. Events are compared by field (t, ball, kind,
-partner), whichever tuple order the revision wrote them in (``_events``). ``--quick`` drops
-the FE reference and the stream reference (the slow ones). Exit code 1 if a non-numeric
-column differs; how large a numeric difference is acceptable is the reader's call: the
-adaptive references take other steps after a 1-ulp change of the force, and a 1-ulp change
-of the stiffness alone moves the FE reference's sensor acceleration by 2.4e-6 of its peak
-(measured on this scene). The active set's own bitwise check is
-``compare_active_set_revisions.py``. ``--keep DIR`` keeps the results there and reuses
-DIR/old.pkl if present (the base is then not run again).
+Runs one scene per solver in this working tree and in ``git archive REV``, each tree in its
+own single-threaded process with its own numba cache, and compares every number they report:
+
+- ``rigid``, ``rigid reference``: the rigid solver and its scipy reference (paper section 4.1:
+  coal balls at 1 and 2 m/s, c = 800 N s/m, 1 s): contact records, events, states sampled at
+  5120 Hz and at every peak;
+- ``coupled``: the two-way coupled modal solver (sandstone at 2 m/s on the closed-form SSSS
+  plate, 5 kHz band, c = 800 N s/m, residual flexibility on): records, events, force nodes;
+- ``FE reference``: the same ball on the Argyris 8x8 plate, dt 2e-7 s, 0.4 ms: records,
+  sensor acceleration;
+- ``stream``, ``stream reference``: the fast stream solver and its slow reference on the
+  ten-ball scene of the tests (15 deg plate, c = 2000 N s/m, d = 2e-5 m: ball-ball contacts,
+  clamp and STEP kinks): records, leaves, events (and the reference's energy);
+- ``stream, modal plate``: the fast stream solver with one ball on the modal plate.
+
+``--quick`` leaves out the FE reference and the stream reference (the slow ones, minutes).
+``--keep DIR`` keeps both trees' results there and reuses DIR/old.pkl if it exists (the base
+is then not run again).
+
+Prints per solver "bit-identical", or the largest difference of any number relative to the
+largest magnitude of its column (and that column); then the numeric columns whose length
+changed (an adaptive reference that took other steps), the non-numeric columns (names, event
+kinds, how contacts ended) that differ, and the columns only this tree has (a record
+extended: the base's columns are compared, and each must still exist). Records are compared
+by their fields and derived values (``as_dict()``: ``restitution``, ...), events by (t, ball,
+kind, partner), an enum as its value. Exit code 1 if a non-numeric column differs; what
+numeric difference is acceptable is the reader's call (docs/development.md, "Checking a
+refactor"). The compiled active set's own bitwise check is ``compare_active_set_revisions.py``.
 """
 
 import argparse
-import dataclasses
 import enum
 import pickle
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
-from compare_active_set_revisions import extract_revision, from_either
-
-ROOT = Path(__file__).resolve().parents[1]
+from revisions import ROOT, extract_revision, from_either, plain, run_in, write_plain
 
 
 def _columns(obj, prefix, out):
-    """Flatten records, tuples, dicts and arrays into named columns (lists of scalars)."""
-    if hasattr(obj, "as_dict") and not isinstance(obj, type):
-        obj = obj.as_dict()  # a record's fields and its derived values (restitution, ...)
-    elif dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        obj = {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
+    """Flatten plain values (``revisions.plain``: dicts, lists, tuples, arrays, scalars) into
+    named columns (lists of scalars)."""
     if isinstance(obj, dict):
         for key, value in obj.items():
             _columns(value, f"{prefix}.{key}", out)
@@ -55,35 +54,33 @@ def _columns(obj, prefix, out):
             _columns(value, f"{prefix}[{i}]" if len(obj) < 8 else f"{prefix}[]", out)
     elif isinstance(obj, np.ndarray):
         out.setdefault(prefix, []).extend(np.ravel(obj).tolist())
-    elif isinstance(obj, enum.Enum):
-        out.setdefault(prefix, []).append(str(obj.value))
     else:
         out.setdefault(prefix, []).append(obj)
 
 
 def _events(events) -> list:
-    """Events as dicts (t, ball, kind, partner), whichever record the revision wrote: the
-    ``Event`` record, or before it (issue 7) the single-ball solvers' (t, ball, kind) tuples
-    (partner: the plate) and the stream solvers' (t, kind, ball, partner) tuples."""
+    """Events as dicts (t, ball, kind, partner): ``Event`` records, or the tuples a revision
+    without them wrote ((t, ball, kind) of a single-ball solver, partner the plate;
+    (t, kind, ball, partner) of a stream solver)."""
     fields = ("t", "ball", "kind", "partner")
     out = []
     for ev in events:
         if hasattr(ev, "_asdict"):
-            out.append(ev._asdict())
+            out.append(plain(ev))
         elif len(ev) == 3:
-            out.append(dict(zip(fields, (*ev, "plate"), strict=True)))
-        elif isinstance(ev[1], enum.Enum):  # the stream solvers' order
+            out.append(plain(dict(zip(fields, (*ev, "plate"), strict=True))))
+        elif isinstance(ev[1], enum.Enum):  # a stream solver's order: the kind second
             t, kind, ball, partner = ev
-            out.append(dict(zip(fields, (t, ball, kind, partner), strict=True)))
+            out.append(plain(dict(zip(fields, (t, ball, kind, partner), strict=True))))
         else:
-            out.append(dict(zip(fields, ev, strict=True)))
+            out.append(plain(dict(zip(fields, ev, strict=True))))
     return out
 
 
 def _nodes(result):
-    """The coupled solver's force nodes, where the revision keeps them (the result itself
-    before 0.3.0, its plate part since)."""
-    return result.nodes if hasattr(result, "nodes") else result.plate.nodes
+    """The coupled solver's force nodes: on the result's plate part, or on the result itself
+    in a revision without one."""
+    return result.plate.nodes if getattr(result, "plate", None) is not None else result.nodes
 
 
 def run_solvers(out_path, quick):
@@ -92,13 +89,12 @@ def run_solvers(out_path, quick):
 
     import tailbeam
     from tailbeam import CARBON_STEEL, COAL, SANDSTONE, Ball, Plate, ball_plate_law
-    from tailbeam.physics.incline import InclinedPlate
 
+    InclinedPlate = from_either("InclinedPlate", "tailbeam.physics.incline")
+    Particle = from_either("Particle", "tailbeam.streams.generator")
     ssss_kirchhoff_basis = from_either(
         "ssss_kirchhoff_basis", "tailbeam.plate.closed_forms", "tailbeam.modal"
     )
-    from tailbeam.streams.generator import Particle
-
     simulate_coupled = from_either(
         "simulate_coupled", "tailbeam.solvers.coupled", "tailbeam.coupled"
     )
@@ -142,8 +138,7 @@ def run_solvers(out_path, quick):
     coupled = simulate_coupled([ball], basis, [slaw], 2e-3, gravity=9.80665)
     runs["coupled"] = (coupled.impacts, _events(coupled.events), _nodes(coupled))
     if not quick:
-        from tailbeam.plate import assemble_plate
-
+        assemble_plate = from_either("assemble_plate", "tailbeam.plate")
         fe_reference = from_either(
             "fe_reference", "tailbeam.solvers.coupled.fe_reference", "tailbeam.coupled.fe_reference"
         )
@@ -171,18 +166,8 @@ def run_solvers(out_path, quick):
     flat = {}
     for name, result in runs.items():
         flat[name] = {}
-        _columns(result, "", flat[name])
-    Path(out_path).write_bytes(pickle.dumps(flat))
-
-
-def _run_in(tree, out_path, cache, quick):
-    code = (f"import sys; sys.path[:0] = [{str(tree)!r}, {str(tree / 'tests')!r}, "
-            f"{str(ROOT / 'benchmarks')!r}]; import compare_revisions as c; "
-            f"c.run_solvers({str(out_path)!r}, {quick!r})")  # fmt: skip
-    env = {"TAILBEAM_CACHE_DIR": str(cache), "NUMBA_CACHE_DIR": str(cache / "numba"),
-           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
-           "PATH": "/usr/bin:/bin"}  # fmt: skip
-    subprocess.run([sys.executable, "-c", code], check=True, cwd=tree, env=env)
+        _columns(plain(result), "", flat[name])
+    write_plain(flat, out_path)
 
 
 def compare(a: dict, b: dict) -> tuple:
@@ -217,8 +202,10 @@ def main(base, quick=False, keep=None):
         store = Path(keep).resolve() if keep else tmp
         store.mkdir(parents=True, exist_ok=True)
         if not (store / "old.pkl").exists():
-            _run_in(extract_revision(base, tmp), store / "old.pkl", tmp / "cache-base", quick)
-        _run_in(ROOT, store / "new.pkl", tmp / "cache-new", quick)
+            call = f"compare_revisions.run_solvers({str(store / 'old.pkl')!r}, {quick!r})"
+            run_in(extract_revision(base, tmp), tmp / "cache-base", call)
+        call = f"compare_revisions.run_solvers({str(store / 'new.pkl')!r}, {quick!r})"
+        run_in(ROOT, tmp / "cache-new", call)
         a = pickle.loads((store / "old.pkl").read_bytes())
         b = pickle.loads((store / "new.pkl").read_bytes())
     ok = True
