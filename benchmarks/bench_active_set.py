@@ -36,6 +36,7 @@ import numpy as np
 from tailbeam import CARBON_STEEL, COAL, Ball, ImpactLaw, Plate, ball_plate_law
 from tailbeam.physics.hertz import hertz_contact_duration, hertz_max_penetration, hertz_peak_force
 from tailbeam.physics.incline import InclinedPlate
+from tailbeam.results.records import EventCode
 from tailbeam.solvers.rigid.model import make_pairs
 from tailbeam.solvers.rigid.solver import _KernelIntegrator
 from tailbeam.solvers.stream.active.set import ActiveSet
@@ -65,14 +66,14 @@ def active_contact(ball, law, rtol, repeat):
             s = ActiveSet([ball.position], [ball.velocity], [ball.mass], [RADIUS], [(0, -1)],
                           [law], (0.0, 0.0, 0.0), (0.3, 0.3), rtol=rtol)  # fmt: skip
             start = s.advance(0.0, 1.0)
-            s.iout[3:6] = 0  # count the contact's work only
+            s.io.reset_stats()  # count the contact's work only
             sets.append((s, start))
         t0 = time.perf_counter()
         ends = [s.advance(start.t, 1.0) for s, start in sets]
         best = min(best, (time.perf_counter() - t0) / len(sets))
         s, start = sets[0]
-        values = {"peak": s.peak[0], "duration": ends[0].t - start.t, "pen": s.pen[0],
-                  "v_out": s.v[0, 2]}  # fmt: skip
+        values = {"peak": s.contacts.peak[0], "duration": ends[0].t - start.t,
+                  "pen": s.contacts.pen[0], "v_out": s.v[0, 2]}  # fmt: skip
         stats = s.stats
     return best, values, stats
 
@@ -144,7 +145,7 @@ def per_step(quick):
                 out = s.advance(0.0, 2e-3)
                 best = min(best, time.perf_counter() - t0)
                 steps = s.stats["steps"]
-                assert out.kind == "t_stop", out
+                assert out.code == EventCode.NONE, out
             rows.append({"n": n, "pairs": p, "all_pairs": all_pairs, "steps": steps,
                          "us_per_step": best / steps * 1e6})  # fmt: skip
             print(f"n={n:3d} P={p:5d} steps={steps:4d} {best / steps * 1e6:8.1f} us/step",

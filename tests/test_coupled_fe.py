@@ -101,7 +101,7 @@ def test_residual_parts_vanish_when_every_mode_is_kept(theory, radius):
 
 # Measured on these meshes at 20 kHz, 200 steps/contact (max over restitution, peak force,
 # duration, max penetration; the peak force is the largest): Kirchhoff 3.0e-5, Mindlin 3.0e-5.
-# The bound asked for in issue 9 (2e-5) is reached from about 28 kHz (benchmarks table).
+# 2e-5 is reached from about 28 kHz (docs/fe-convergence.md).
 CONTACT_BOUND_20KHZ = {"kirchhoff": 4e-5, "mindlin": 4e-5}
 
 

@@ -58,7 +58,7 @@ def test_first_contact_points_follow_the_free_fall():
 @pytest.mark.parametrize("tail_modes", [None, "auto"])
 @pytest.mark.parametrize("theory", ["kirchhoff", "mindlin"])
 def test_ritz_tail_scene_reaches_the_fe_reference_at_20_khz(runs, theory, tail_modes):  # noqa: F811
-    # Issue 9: 2e-5 on restitution, peak force, duration and max penetration at 20 kHz with
+    # The target: 2e-5 on restitution, peak force, duration and max penetration at 20 kHz with
     # the default settings (tail "auto" = Ritz here, k = 32) and 200 steps/contact.
     # Measured: Kirchhoff 8x8 1.64e-5, Mindlin 6x6 1.66e-5 (the a posteriori "auto" k is
     # 32 on both; the rest is the time step's +1.6e-5 on the restitution), where the

@@ -1,4 +1,4 @@
-"""The active set's event restart across returns (issue 7, grazing contacts).
+"""The active set's event restart across returns (grazing contacts).
 
 An event the kernel applies leaves its row's function on 0 at that instant. Inside one
 ``advance`` call the row is searched from ``cheb_events.FRESH_S`` on in the next step (it is

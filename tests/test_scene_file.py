@@ -145,7 +145,7 @@ MODAL = BASE.replace("duration = 1.0", "duration = 1.0\n[plate]\nmodel = 'modal'
 
 def test_balls_whose_paths_touch():
     """Balls that may touch go to the stream solver, on the rigid plate and on the modal
-    plate (whose sensors then follow the stream's plate forces one way; issue 7)."""
+    plate."""
     second = BASE.split("duration = 1.0")[1].replace('name = "a"', 'name = "b"')
     # Directly above the first ball: they would collide.
     above = second.replace("0.0, 0.0, 0.05", "0.0, 0.0, 0.2")

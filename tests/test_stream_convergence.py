@@ -1,5 +1,5 @@
 """A many-ball two-way run on the modal plate converges with the tolerance and the band at a
-measured order (issue 7). Truth: the same scene at a much tighter tolerance / a much wider band
+measured order. Truth: the same scene at a much tighter tolerance / a much wider band
 (self-convergence); the orders are the measured ones of
 ``python benchmarks/study_stream_convergence.py`` (DOP853 with its error per unit step: ~1 in
 rtol; the band without residual flexibility at the contacts: ~1.9).

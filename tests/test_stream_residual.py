@@ -1,4 +1,4 @@
-"""Residual flexibility at the stream solver's plate contacts (two-way modal plate, issue 7)
+"""Residual flexibility at the stream solver's plate contacts (two-way modal plate)
 against independent truths:
 
 - the scalar solve ``plate_force_with_residual`` against scipy's brentq on the closed form

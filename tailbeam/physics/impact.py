@@ -14,15 +14,12 @@ region's border, up to the event that switches region.
 
 Every function here is compiled with numba (``njit(cache=True, inline="always")``): callable
 from the compiled integrators (rigid, coupled, active-set kernels) and from Python (the
-references, and the array wrappers of ``tailbeam.physics.contact_law``). Inlined into the kernels at
-numba's IR level, so a kernel that asks for several pieces at one point (the rigid kernel's
-watched functions) computes delta^e once: the rigid solver of
-``benchmarks/time_revisions.py`` (10 balls, 1 s, rtol 1e-10) took 3.5-3.6 ms of CPU against
-3.9-4.0 ms without ``inline`` and 3.9-4.0 ms with the copies of the law this module replaced.
-The solvers differ in how they integrate and find events, never in the formula.
-``tests/test_impact_core.py`` checks the core against eq. 5 written out, Adams' STEP end
-conditions, finite-difference derivatives and the work of the elastic force.
-"""
+references, and the array wrappers of ``tailbeam.physics.contact_law``). Inlined into the
+kernels at numba's IR level, so a kernel that asks for several pieces at one point (the rigid
+kernel's watched functions) computes delta^e once. The solvers differ in how they integrate and
+find events, never in the formula. ``tests/test_impact_core.py`` checks the core against eq. 5
+written out, Adams' STEP end conditions, finite-difference derivatives and the work of the
+elastic force."""
 
 import math
 

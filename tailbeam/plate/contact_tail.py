@@ -14,9 +14,8 @@ omega_i^(2m+2) for m < 2k: the static compliance (m = 0) and the slow part of th
 response, as the single-ball solver's Ritz tail does on the FE model
 (tailbeam.plate.ritz_tail). The rest of the band's residual compliance, C_res - sum_j
 b_j^2 / nu_j^2 (the modes above the wider band), stays a static spring in series, so the
-contact's static compliance is the quasi-static tail's. ``benchmarks/probe_stream_tail.py``
-measured this model against all modes to 40 kHz at a 10 kHz band: every lump size within
-0.3 % with k = 3-4, against 1.55 % for the static spring alone.
+contact's static compliance is the quasi-static tail's. Its accuracy against all modes to
+40 kHz at a 10 kHz band: docs/streams.md (``benchmarks/bench_stream_band_size.py``).
 
 The oscillators belong to one plate pair (a ball on the plate) at one contact point: they
 start at rest when its contact starts there, keep moving while the ball bounces off and lands

@@ -3,11 +3,9 @@
 Numba's runtime (NRT) reference-counts arrays atomically: every array handed to a compiled
 function that is not inlined, and every array unpacked from a tuple, costs an atomic
 increment and decrement (~50 cycles). The active-set kernel calls small helpers (the
-right-hand side, the event rows) hundreds of times per step with 10-25 arrays each, so the
-counting dominated: 11 us per step for one ball, against 0.9 us for the rigid kernel (with
-the helpers below: 2.5 us for one ball, 9 us for eight, from 50; results bit-identical). The
-rigid kernel's parts (``rigid.kernel``, ``rigid.dop853``) are helpers too: as plain ``njit``
-functions they made the kernel 40 % slower (measured with ``benchmarks/time_revisions.py``).
+right-hand side, the event rows) hundreds of times per step with 10-25 arrays each, so with
+the counting the kernel spent most of its time on it. The rigid kernel's parts
+(``rigid.kernel``, ``rigid.step``, ``numerics.dop853``) are helpers too.
 
 ``_nrt=False`` compiles a function without the runtime: no reference counting. It is safe for
 functions that never allocate, return or store an array (they only read and write the
