@@ -48,11 +48,10 @@ from tailbeam.physics.impact import (
     clamp_indicator,
     elastic_energy,
     elastic_stiffness,
+    region_damping,
+    region_damping_slope,
     region_force,
 )
-from tailbeam.physics.impact import power as _pow  # noqa: F401  (the names callers use)
-from tailbeam.physics.impact import region_damping as damping_in_region  # noqa: F401
-from tailbeam.physics.impact import region_damping_slope as damping_slope
 from tailbeam.solvers.numerics.jit import helper_njit
 
 L_CRES = LAW_COLUMNS  # the residual compliance C (m/N), after the law's own columns
@@ -74,8 +73,8 @@ def residual_rate(delta, rate0, acc0, k, e, c, d, ramp, cres):
     (drops C F'' there): the root of C c s' delta'^2 + (1 + C k e delta^(e-1)) delta' -
     (delta0' - C c s delta0'') = 0 that tends to delta0' as C -> 0."""
     pos = delta if delta > 0.0 else 0.0
-    r = rate0 - cres * damping_in_region(pos, c, d, ramp) * acc0
-    a = cres * damping_slope(pos, c, d, ramp)
+    r = rate0 - cres * region_damping(pos, c, d, ramp) * acc0
+    a = cres * region_damping_slope(pos, c, d, ramp)
     b = 1.0 + cres * elastic_stiffness(pos, k, e)
     disc = b * b + 4.0 * a * r
     return 2.0 * r / (b + math.sqrt(max(disc, 0.25 * b * b)))

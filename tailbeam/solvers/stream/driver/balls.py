@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from tailbeam.physics.contacts import PLATE, LawOptions  # noqa: F401 (LawOptions: re-exported)
+from tailbeam.physics.contacts import PLATE
 from tailbeam.solvers.numerics.flight import advance, band_time, edge_time, pair_time, plate_time
 
 PENDING, FLY, SLIDE, ACTIVE, GONE = range(5)

@@ -33,11 +33,11 @@ import numpy as np
 
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.contact_law import HERTZ_EXPONENT
-from tailbeam.physics.contacts import contact_table
+from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import note, quiet, task
 from tailbeam.solvers.stream.active.members import ActiveMembers
-from tailbeam.solvers.stream.driver.balls import SLIDE, Balls, LawOptions
+from tailbeam.solvers.stream.driver.balls import SLIDE, Balls
 from tailbeam.solvers.stream.driver.clock import Clock
 from tailbeam.solvers.stream.driver.energy import EnergyLedger
 from tailbeam.solvers.stream.driver.heap import Predictions
