@@ -66,7 +66,7 @@ def configure_numba_cache() -> Path:
 # two_balls_rigid, modal_plate, small_stream with an empty cache, minus a cached run)
 COMPILE_SECONDS = {"rigid": "~10 s", "coupled": "~30 s", "stream": "~25 s"}
 # The source folder of each solver's kernels (numba names its cache folders after it)
-KERNEL_FOLDERS = {"rigid": "rigid", "coupled": "coupled", "stream": "active"}
+KERNEL_FOLDERS = {"rigid": "rigid", "coupled": "coupled", "stream": "compiled"}
 
 
 def announce_first_compile(solver: str = "rigid") -> None:

@@ -34,11 +34,12 @@ def test_region_force_equals_the_law_inside_each_region():
 
 
 def test_compiled_twins_equal_the_region_helpers():
-    """The numba twins in tailbeam.solvers.stream.active.pairs (used by the active-set kernel) give
-    the same force, clamp indicator and elastic energy as the helpers above, in every region
-    and for exponents 1, 1.5 (the x sqrt(x) branch), 2 (its own clamp limit) and 2.2."""
+    """The numba twins in tailbeam.solvers.stream.active.compiled.pairs (used by the active-set
+    kernel) give the same force, clamp indicator and elastic energy as the helpers above, in
+    every region and for exponents 1, 1.5 (the x sqrt(x) branch), 2 (its own clamp limit) and
+    2.2."""
     from tailbeam.physics.contact_law import ImpactLaw
-    from tailbeam.solvers.stream.active import pairs as ap
+    from tailbeam.solvers.stream.active.compiled import pairs as ap
 
     rng = np.random.default_rng(11)
     for e in (1.0, 1.5, 2.0, 2.2):

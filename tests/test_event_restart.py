@@ -19,8 +19,8 @@ from tailbeam import CARBON_STEEL, COAL, Ball, ball_ball_law, ball_plate_law
 from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.results.records import EventCode
+from tailbeam.solvers.stream.active.compiled.pairs import R_CONTACT
 from tailbeam.solvers.stream.active.members import ActiveMembers
-from tailbeam.solvers.stream.active.pairs import R_CONTACT
 from tailbeam.solvers.stream.active.set import ActiveSet
 from tailbeam.solvers.stream.driver.balls import Balls
 from tailbeam.streams.generator import Particle
@@ -143,7 +143,7 @@ def _table(particles, incline):
 
 def test_set_fresh_keeps_at_most_the_kernel_capacity():
     """More markers than the kernel holds are cut to its capacity (MAX_FRESH), not an error."""
-    from tailbeam.solvers.stream.active.kernel import MAX_FRESH
+    from tailbeam.solvers.stream.active.compiled.kernel import MAX_FRESH
 
     s = _touching_pair(0.5 * BAND, T0, fresh=False)
     s.io.set_fresh(T0, [(R_CONTACT, 0)] * (MAX_FRESH + 3))

@@ -75,7 +75,7 @@ def test_numba_cache_follows_every_source_file(tmp_path):
 
     before = fingerprint()
     assert before == source_fingerprint()  # same sources, same folder (another checkout too)
-    helper = package / "solvers" / "stream" / "active" / "pairs.py"
+    helper = package / "solvers" / "stream" / "active" / "compiled" / "pairs.py"
     helper.write_text(helper.read_text() + "\n# edited\n")
     assert fingerprint() != before
 

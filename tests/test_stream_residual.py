@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 from tailbeam import SANDSTONE, Ball, ball_plate_law
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import CARBON_STEEL
-from tailbeam.solvers.stream.active import pairs as ap
+from tailbeam.solvers.stream.active.compiled import pairs as ap
 from tailbeam.solvers.stream.driver.loop import solve_stream
 from tailbeam.solvers.stream.plate import StreamPlate
 from tailbeam.streams.generator import Particle

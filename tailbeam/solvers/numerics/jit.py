@@ -20,8 +20,8 @@ a plain ``njit`` helper in a per-step loop cost the coupled kernel 10 % (their m
 counted one by one), so its loop calls such helpers only when there is an event to locate.
 
 ``_nrt`` is a numba target option since 0.19 (listed in ``numba.core.cpu``'s options, not in
-the user documentation: see numba issues 1204, 2350). If a numba release dropped it,
-``HELPER_OPTIONS`` falls back to plain ``njit`` (slower, same results).
+the user documentation: numba/numba#1204 and #2350 on its tracker). If a numba release
+dropped it, ``HELPER_OPTIONS`` falls back to plain ``njit`` (slower, same results).
 """
 
 from numba import njit

@@ -70,17 +70,12 @@ class Stream(Solver):
             _setting(options.max_steps, self.max_steps),
         )
         self._announce(scene, rtol, max_steps)
-        stream_plate = _stream_plate(plate)
         with _bar(scene) as advance:
-            run = solve_stream(
-                scene.particles, scene.incline, scene.duration, rtol=rtol, max_work=max_steps,
-                progress=advance, plate=stream_plate, contacts=scene.contacts(),
+            return simulate_stream(
+                scene.particles, scene.incline, scene.duration, laws=scene.contacts(),
+                rtol=rtol, max_steps=max_steps, progress=advance, setup=plate,
+                sensors=scene.sensors, info={"solver_choice": self.name},
             )  # fmt: skip
-        info = {"solver": "fast stream solver (event-driven, active-set DOP853)"}
-        return stream_result(
-            run, scene.incline, scene.duration, plate=_response(plate, run),
-            sensors=scene.sensors, info=_info(info, plate, self.name),
-        )  # fmt: skip
 
     def _announce(self, scene, rtol, max_steps):
         memory, worst = self.estimate(len(scene.particles), max_steps)
@@ -134,8 +129,8 @@ class StreamReference(Stream):
 
 def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
                     rtol: float = DEFAULT_RTOL, max_steps: int = DEFAULT_MAX_STEPS,
-                    progress=True, rest_speed: float = DEFAULT_REST_SPEED,
-                    plate: StreamPlate | None = None) -> Result:  # fmt: skip
+                    progress=True, rest_speed: float = DEFAULT_REST_SPEED, setup=None,
+                    sensors=(), info=None) -> Result:  # fmt: skip
     """The fast stream solver on ``particles`` (``tailbeam.streams.generator.Particle``).
 
     Parameters
@@ -149,20 +144,28 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         The driver's tolerance, work bound (steps and events) and rest speed (m/s).
     progress : bool or callable
         A bar, nothing, or a callable taking the simulated time reached (s).
-    plate : StreamPlate, optional
-        The two-way modal plate (None: the rigid plate).
+    setup : tailbeam.solvers.modal_setup.setup.ModalSetup, optional
+        The modal plate (None: the rigid plate): two-way, its modes in the active sets, or
+        one-way; either way the plate loads drive its modes for the sensors.
+    sensors : tuple of SensorSpec
+        The sensors the result's plate response is read at.
+    info : dict, optional
+        More entries for ``Result.info``.
     """
-    contacts = contact_table(particles, laws, incline.plate.material)
     run = solve_stream(
         particles, incline, duration, rtol=rtol, rest_speed=rest_speed, max_work=max_steps,
-        progress=progress, plate=plate, contacts=contacts,
+        progress=progress, plate=_stream_plate(setup),
+        contacts=contact_table(particles, laws, incline.plate.material),
     )  # fmt: skip
-    response = None
-    if plate is not None:
-        response = LoadResponse.from_records(plate.basis, plate.zeta, run.loads, run.dead_loads,
-                                             quasi_static=plate.residual_flexibility)  # fmt: skip
-    info = {"solver": "fast stream solver (event-driven, active-set DOP853)"}
-    return stream_result(run, incline, duration, plate=response, info=info)
+    number_contacts(run.contacts, run.leaves, incline)
+    return Result(
+        duration=duration, particles=tuple(run.particles),
+        impacts=sorted(run.contacts, key=lambda r: (r.t_start, r.ball)), events=run.events,
+        leaves=run.leaves, status=run.status, message=run.message, stats=run.stats,
+        info={"solver": "fast stream solver (event-driven, active-set DOP853)",
+              **(setup.info() if setup else {}), **(info or {})},
+        sensors=tuple(sensors), plate=_response(setup, run),
+    )  # fmt: skip
 
 
 def simulate_reference(
@@ -186,18 +189,6 @@ def simulate_reference(
     )  # fmt: skip
 
 
-def stream_result(run, incline, duration, *, plate=None, sensors=(), info=None) -> Result:
-    """The Result of a fast stream run (``StreamRun``): its contacts numbered
-    (``number_contacts``) and in impacts.csv's row order; ``plate`` its plate response."""
-    number_contacts(run.contacts, run.leaves, incline)
-    return Result(
-        duration=duration, particles=tuple(run.particles),
-        impacts=sorted(run.contacts, key=lambda r: (r.t_start, r.ball)), events=run.events,
-        leaves=run.leaves, status=run.status, message=run.message, stats=run.stats,
-        info=dict(info or {}), sensors=tuple(sensors), plate=plate,
-    )  # fmt: skip
-
-
 def _setting(value, default):
     return default if value is None else value
 
@@ -216,10 +207,6 @@ def _response(setup, run) -> LoadResponse | None:
         return None
     return LoadResponse.from_records(setup.basis, setup.zeta, run.loads, run.dead_loads,
                                      quasi_static=setup.settings.residual_flexibility)  # fmt: skip
-
-
-def _info(solver_info, setup, name) -> dict:
-    return {**solver_info, **(setup.info() if setup else {}), "solver_choice": name}
 
 
 @contextlib.contextmanager

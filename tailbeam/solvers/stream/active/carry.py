@@ -9,7 +9,7 @@ edge row, and given to the rebuilt set under its own indices.
 
 import math
 
-from tailbeam.solvers.stream.active.pairs import R_EDGE
+from tailbeam.solvers.stream.active.compiled.pairs import R_EDGE
 
 
 class CarriedRows:

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from tailbeam.physics.contact_law import LAW_C, LAW_COLUMNS, LAW_D
-from tailbeam.solvers.stream.active.pairs import clamp_indicator
+from tailbeam.solvers.stream.active.compiled.pairs import clamp_indicator
 
 
 class ContactStates:

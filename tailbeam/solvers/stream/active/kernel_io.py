@@ -15,8 +15,8 @@ import numpy as np
 
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.results.records import EventCode
-from tailbeam.solvers.stream.active import kernel as ak
-from tailbeam.solvers.stream.active.pairs import R_EDGE
+from tailbeam.solvers.stream.active.compiled import kernel as ak
+from tailbeam.solvers.stream.active.compiled.pairs import R_EDGE
 
 
 @dataclass(frozen=True)

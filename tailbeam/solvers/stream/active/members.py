@@ -21,8 +21,8 @@ from tailbeam.physics.contacts import PLATE
 from tailbeam.physics.incline import EDGES
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.stream.active.carry import CarriedRows
+from tailbeam.solvers.stream.active.compiled.pairs import first_contact_step
 from tailbeam.solvers.stream.active.forces import PlateForces
-from tailbeam.solvers.stream.active.pairs import first_contact_step
 from tailbeam.solvers.stream.active.plate_pairs import PlatePairs
 from tailbeam.solvers.stream.active.rest import excess_energy, place_at_rest, static_height
 from tailbeam.solvers.stream.active.set import ActiveSet

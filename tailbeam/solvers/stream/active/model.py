@@ -13,7 +13,7 @@ import numpy as np
 
 from tailbeam.errors import InputError
 from tailbeam.physics.contact_law import LAW_COLUMNS, law_table
-from tailbeam.solvers.stream.active.pairs import L_CRES
+from tailbeam.solvers.stream.active.compiled.pairs import L_CRES
 
 
 class Model:

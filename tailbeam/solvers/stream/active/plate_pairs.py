@@ -13,7 +13,7 @@ by pair key across rebuilds of the set; ``block`` gives the modal inputs of a re
 import numpy as np
 
 from tailbeam.physics.contact_patch import load_radius
-from tailbeam.solvers.stream.active.pairs import L_CRES
+from tailbeam.solvers.stream.active.compiled.pairs import L_CRES
 from tailbeam.solvers.stream.active.rest import static_height
 from tailbeam.solvers.stream.active.shapes import ShapeCache
 from tailbeam.solvers.stream.active.tails import Tails

@@ -7,7 +7,7 @@ of that penetration. The normal motion above this state is removed; the energy i
 returned for the driver's ledger.
 """
 
-from tailbeam.solvers.stream.active.pairs import settle_excess
+from tailbeam.solvers.stream.active.compiled.pairs import settle_excess
 
 
 def static_height(balls, i: int, compliance: float) -> float:

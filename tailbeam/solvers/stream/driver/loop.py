@@ -59,7 +59,7 @@ STUCK_LIMIT = 5_000  # loop rounds without time moving before the run is stopped
 
 @dataclass
 class StreamRun:
-    """What the stream solver found (``tailbeam.solvers.stream.stream_result`` presents it).
+    """What the stream driver found (``tailbeam.solvers.stream.solver`` makes it a Result).
 
     Attributes
     ----------
@@ -182,7 +182,7 @@ def _run(sim, duration, progress) -> "StreamRun":
 class _Stuck(WorkLimitError):
     """Contacts start and end again at one instant: no progress (a grazing contact). The
     active set carries the events it applied at an instant into its next call from there
-    (``tailbeam.solvers.stream.active.kernel.advance``); the retry is a safety net."""
+    (``tailbeam.solvers.stream.active.compiled.kernel.advance``); the retry is a safety net."""
 
 
 class _CallbackBar:

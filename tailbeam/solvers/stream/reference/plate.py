@@ -24,8 +24,8 @@ Mode shapes (``shapes``):
   frictionless reaction of the tilted deflected surface to first order in its slope
   (~1e-5 here); the fast stream solver leaves it out.
 * ``"frozen"``: while a plate contact lasts it keeps the shapes at its first touch and has no
-  slope term (the fast solver's contact model: ``tailbeam.solvers.stream.active.pairs``); before a
-  touch the gap is exact. Comparing both variants measures what freezing costs.
+  slope term (the fast solver's contact model: ``tailbeam.solvers.stream.active.compiled.pairs``);
+  before a touch the gap is exact. Comparing both variants measures what freezing costs.
 
 grad phi is a central difference of the basis (step ``GRADIENT_STEP``: relative error
 ~(k h)^2 / 6 < 1e-7 of the slope for wavenumbers k < 100 /m, itself ~1e-5 of the force).

@@ -10,9 +10,9 @@ contact would stall).
 
 from tailbeam.solvers.numerics.chebyshev import FRESH_S
 from tailbeam.solvers.numerics.jit import helper_njit
-from tailbeam.solvers.stream.active.events import is_fresh
-from tailbeam.solvers.stream.active.pairs import row_value
-from tailbeam.solvers.stream.active.step import EPS, dense_state
+from tailbeam.solvers.stream.active.compiled.events import is_fresh
+from tailbeam.solvers.stream.active.compiled.pairs import row_value
+from tailbeam.solvers.stream.active.compiled.step import EPS, dense_state
 
 MAX_FRESH = 16  # rows a fresh table holds
 

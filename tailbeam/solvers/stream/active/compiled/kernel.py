@@ -46,9 +46,9 @@ from tailbeam.results.records import EventCode
 from tailbeam.solvers.numerics.chebyshev import interpolant_max
 from tailbeam.solvers.numerics.dop853 import growth, shrink
 from tailbeam.solvers.numerics.jit import helper_njit
-from tailbeam.solvers.stream.active.events import detect, prepare
-from tailbeam.solvers.stream.active.fresh import MAX_FRESH, found_again, hand_back, mark
-from tailbeam.solvers.stream.active.pairs import (
+from tailbeam.solvers.stream.active.compiled.events import detect, prepare
+from tailbeam.solvers.stream.active.compiled.fresh import MAX_FRESH, found_again, hand_back, mark
+from tailbeam.solvers.stream.active.compiled.pairs import (
     R_CONTACT,
     R_EDGE,
     R_FULL,
@@ -61,7 +61,7 @@ from tailbeam.solvers.stream.active.pairs import (
     row_value,
     settle_excess,
 )
-from tailbeam.solvers.stream.active.step import (
+from tailbeam.solvers.stream.active.compiled.step import (
     EPS,
     dense_coef,
     dense_component,

@@ -17,7 +17,7 @@ import numpy as np
 
 from tailbeam.solvers.numerics.dop853 import dense_rows
 from tailbeam.solvers.numerics.jit import helper_njit
-from tailbeam.solvers.stream.active.pairs import rhs, rhs_arrays
+from tailbeam.solvers.stream.active.compiled.pairs import rhs, rhs_arrays
 
 EPS = 2.220446049250313e-16
 

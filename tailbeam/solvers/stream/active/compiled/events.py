@@ -22,7 +22,7 @@ from tailbeam.solvers.numerics.chebyshev import (
     illinois_update,
 )
 from tailbeam.solvers.numerics.jit import helper_njit
-from tailbeam.solvers.stream.active.pairs import (
+from tailbeam.solvers.stream.active.compiled.pairs import (
     L_CRES,
     R_CLAMP,
     R_CONTACT,
@@ -33,7 +33,7 @@ from tailbeam.solvers.stream.active.pairs import (
     row_value,
     row_value_arrays,
 )
-from tailbeam.solvers.stream.active.step import EPS, dense_state, ensure_ball, ensure_plate
+from tailbeam.solvers.stream.active.compiled.step import EPS, dense_state, ensure_ball, ensure_plate
 
 
 @helper_njit
