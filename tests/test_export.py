@@ -119,6 +119,7 @@ def simulated(tmp_path_factory):
     return tmp
 
 
+@pytest.mark.slow
 def test_simulate_export_equals_sensors_csv(simulated):
     out = simulated / "out"
     sensors = read_csv(out / "sensors.csv")  # t_S1, S1, t_edge_2, edge_2 (rates differ)
@@ -140,6 +141,7 @@ def test_simulate_export_equals_sensors_csv(simulated):
     assert '"uff/tiny.uff"' in manifest and '"uff/labels.csv"' in manifest
 
 
+@pytest.mark.slow
 def test_sep005_channels_of_a_result(simulated):
     from tailbeam.io.scene_file import load_scene
     from tailbeam.io.sep005 import sep005_channels
@@ -194,6 +196,7 @@ def swept(tmp_path_factory):
     return tmp / "out"
 
 
+@pytest.mark.slow
 def test_sweep_export_holds_every_finished_case(swept):
     import pandas as pd
     import xarray as xr
@@ -222,6 +225,7 @@ def test_sweep_export_holds_every_finished_case(swept):
                 assert (s["id2"], s["id4"]) == (Path(row["file"]).stem, row["label"])
 
 
+@pytest.mark.slow
 def test_export_command_rewrites_the_same_files(swept, tmp_path, capsys):
     out = tmp_path / "again"
     assert main(["export", str(swept), "--format", "uff58", "--out", str(out)]) == 0
