@@ -10,7 +10,7 @@ import argparse
 import sys
 
 from tailbeam._version import __version__
-from tailbeam.cli import features, learn, modes, reproduce, simulate, sweep
+from tailbeam.cli import export, features, learn, modes, reproduce, simulate, sweep
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.progress import set_quiet
 
@@ -24,6 +24,7 @@ COMMANDS = {
     "sweep": (sweep, "run a parameter sweep on Dask and write a labelled dataset (Zarr, Parquet)"),
     "features": (features, "compute signal features of a sweep dataset into features.parquet"),
     "learn": (learn, "cross-validated scikit-learn baseline: how separable coal and gangue are"),
+    "export": (export, "write a dataset's signals as UFF 58 files (one per case) and labels.csv"),
 }
 
 

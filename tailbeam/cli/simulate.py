@@ -7,7 +7,8 @@ Writes impacts.csv (every column of ``Result.impacts_table``), particles.csv, im
 and manifest.json into DIR, for every scene (tailbeam.results.result); timeseries.csv (uniform grid)
 when the solver keeps the balls' states (single balls, rigid or modal plate: not the stream
 solver); on a modal plate with sensors also sensors.csv, sensor_spectra.csv and one
-sensor_<name>.png (time and spectrum) per sensor.
+sensor_<name>.png (time and spectrum) per sensor. --export uff58 also writes the sensor records
+as DIR/uff/<scene>.uff and DIR/uff/labels.csv (tailbeam.cli.export).
 
 Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
 scene and --out are fully validated before the solver runs, and the results replace DIR
@@ -15,6 +16,7 @@ whole (tailbeam.io.output), so DIR never mixes two runs.
 """
 
 from tailbeam.cachedir import announce_first_compile
+from tailbeam.cli import export
 from tailbeam.io.output import atomic_output_dir, check_output_dir, describe
 from tailbeam.progress import task
 
@@ -33,6 +35,7 @@ def add_arguments(parser):
         "stream solver), single-ball, stream or stream-reference (the slow independent "
         "reference, rigid plate, <= 20 bodies): run one scene through two to compare them",
     )
+    export.add_export_option(parser, "the sensor records (DIR/uff/)")
 
 
 def write_results(out_dir, scene, result) -> list:
@@ -90,6 +93,8 @@ def run(args) -> int:
     check_output_dir(args.out)
     scene = load_scene(args.scene)
     solver = choose_solver(scene, args.solver, "--solver")
+    if export.chosen(args):
+        export.check_run_export(scene)
     if solver.name == "stream":
         announce_first_compile("stream")
     elif solver.name == "single-ball":
@@ -97,6 +102,8 @@ def run(args) -> int:
     result = simulate(scene, solver=solver.name)
     with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:
         files = write_results(tmp, scene, result)
+        if export.chosen(args):
+            files += export.write_run_uff(tmp, args.scene, scene, result)
     n = len(result.impacts)
     names = ", ".join(f.name for f in files)
     print(f"{args.scene}: {n} impacts; wrote {names} to {args.out}")

@@ -3,9 +3,13 @@ sweep on Dask and write a labelled dataset (tailbeam.study; needs ``tailbeam[stu
 
 The sweep file and every case's scene are validated before any work (one-line errors, exit
 code 2). Writes DIR/dataset.zarr, DIR/impacts.parquet and DIR/cases.csv; running it again
-skips finished cases and retries failed ones.
+skips finished cases and retries failed ones. --export uff58 then writes every finished case
+as DIR/uff/case_<id>.uff with DIR/uff/labels.csv (tailbeam.study.export).
 """
 
+from pathlib import Path
+
+from tailbeam.cli import export
 from tailbeam.errors import InputError
 
 
@@ -19,6 +23,7 @@ def add_arguments(parser):
     where.add_argument(
         "--scheduler", default=None, help="address of a running Dask scheduler (tcp://host:port)"
     )
+    export.add_export_option(parser, "every finished case (DIR/uff/)")
 
 
 def run(args) -> int:
@@ -32,10 +37,28 @@ def run(args) -> int:
 
     spec = load_sweep(args.sweep)
     cases = expand(spec)  # every case's scene validated before a worker starts
+    if export.chosen(args):
+        from tailbeam.io.output import check_output_dir
+
+        check_output_dir(Path(args.out) / "uff", field="--export")
     s = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, cases=cases)
     ran = s["ok"] + s["failed"]
     print(
         f"{args.sweep}: {s['cases']} cases, {s['skipped']} already done, {ran} run "
         f"({s['ok']} ok, {s['failed']} failed); dataset in {args.out}"
     )
+    for fmt in export.chosen(args):
+        _export(args, fmt)
     return 1 if s["failed"] else 0
+
+
+def _export(args, fmt: str) -> None:
+    from tailbeam.progress import note
+    from tailbeam.study.export import export_dataset
+
+    if not (Path(args.out) / "dataset.zarr").is_dir():
+        note(f"sweep: no finished case, nothing to export as {fmt}")
+        return
+    out = Path(args.out) / "uff"
+    e = export_dataset(args.out, out, fmt, command=f"tailbeam sweep {args.sweep} --export {fmt}")
+    print(f"{args.sweep}: {e['cases']} finished cases written as UFF 58 files to {out}")
