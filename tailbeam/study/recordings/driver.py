@@ -117,7 +117,13 @@ def _positions(plan, sink) -> tuple:
     return out
 
 
+def _sensor_map(src, sensors) -> dict:
+    """channel name in the file -> sensor name."""
+    return dict(zip([src.channels[i] for i in src.order], sensors, strict=True))
+
+
 def _attrs(plan, command: str, files: list) -> dict:
+    pairs = list(zip(plan.sources, files, strict=True))
     return {
         "title": "tailbeam import: measured vibration records, labelled",
         "tailbeam_version": __version__,
@@ -129,10 +135,9 @@ def _attrs(plan, command: str, files: list) -> dict:
         "case_scenes": {},
         "import_command": command,
         "import_labels_file": str(plan.labels_path),
-        "import_sources": json_attr([s.provenance(f) for s, f in zip(plan.sources, files, strict=True)]),
+        "import_sources": json_attr([s.provenance(f) for s, f in pairs]),
         "import_channel_rule": CHANNEL_RULE,
-        "import_sensor_map": json_attr({f: dict(zip([s.channels[i] for i in s.order], plan.sensors, strict=True))
-                                        for s, f in zip(plan.sources, files, strict=True)}),
+        "import_sensor_map": json_attr({f: _sensor_map(s, plan.sensors) for s, f in pairs}),
         "import_resampling": RESAMPLING,
         "import_cut": json_attr({"cut": plan.cut, "length_s": plan.n_time / plan.fs,
                                  "pre_s": plan.pre / plan.fs, **vars(plan.onsets)}),

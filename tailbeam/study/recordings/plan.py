@@ -144,8 +144,9 @@ def _source(given: str, rows_by_file: dict, labels_name: str) -> Source:
             raise InputError(given, "holds no samples")
         rate = _rate(rec, row, labels_name)
         units, factors = _units(rec, row, labels_name)
-        return Source(path, row, rec.reader, list(rec.channels), rate, units, factors,
-                      list(range(len(rec.channels))), rec.n_samples, details=rec.details)  # fmt: skip
+        order = list(range(len(rec.channels)))
+        return Source(path, row, rec.reader, list(rec.channels), rate, units, factors, order,
+                      rec.n_samples, details=rec.details)  # fmt: skip
     finally:
         rec.close()
 
@@ -163,8 +164,10 @@ def _match_sensors(sources: list, files: list) -> list:
 
 
 def build_plan(files, labels, *, sample_rate=None, cut="file", length=None, pre=0.005,
-               onsets=OnsetOptions()) -> Plan:  # fmt: skip
-    """Check everything; the Plan of the import, or InputError (one line)."""
+               onsets=None) -> Plan:  # fmt: skip
+    """Check everything; the Plan of the import, or InputError (one line). ``onsets``:
+    OnsetOptions (default: its defaults)."""
+    onsets = onsets or OnsetOptions()
     if cut not in CUTS:
         raise InputError("--cut", f"must be one of {', '.join(CUTS)}, got {cut!r}")
     if sample_rate is not None and not sample_rate > 0:

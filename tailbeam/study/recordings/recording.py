@@ -87,4 +87,6 @@ def check_channels(path, channels: list, lengths: list) -> None:
     if len(set(channels)) != len(channels):
         raise InputError(str(path), f"channel names repeat: {channels}")
     if len(set(lengths)) > 1:
-        raise InputError(str(path), f"channels differ in length: {dict(zip(channels, lengths))}")
+        raise InputError(
+            str(path), f"channels differ in length: {dict(zip(channels, lengths, strict=True))}"
+        )
