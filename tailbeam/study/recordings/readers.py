@@ -64,4 +64,10 @@ def open_recording(path) -> Recording:
         raise InputError(str(path), f"unknown extension {path.suffix!r}; known: {known}")
     if not path.is_file():
         raise InputError(str(path), "no such file")
-    return opener(path)
+    try:
+        return opener(path)
+    except ModuleNotFoundError as err:
+        raise InputError(
+            "dependencies",
+            f"{err.name} not installed; install it with pip install 'tailbeam[study]'",
+        ) from None
