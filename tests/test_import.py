@@ -60,13 +60,34 @@ def _uff58(name, node, data, fs):
                            "z_axis_len_unit_exp", "z_axis_force_unit_exp",
                            "z_axis_temp_unit_exp"), 0)  # fmt: skip
     return pyuff.prepare_58(
-        binary=0, z_axis_value=0.0, id1="test", id2="case 0", id3=name, id4="coal", id5="", func_type=1,
-        rsp_ent_name=name, rsp_node=node, rsp_dir=3, ref_ent_name="none", ord_data_type=4,
-        num_pts=len(data), abscissa_spacing=1, abscissa_min=0.0, abscissa_inc=1.0 / fs,
-        abscissa_spec_data_type=17, abscissa_axis_units_lab="s", ordinate_spec_data_type=12,
-        ordinate_len_unit_exp=1, ordinate_axis_units_lab="g", orddenom_axis_units_lab="",
-        z_axis_axis_units_lab="", data=data, x=np.arange(len(data)) / fs, **zeros,
-    )  # fmt: skip
+        binary=0,
+        z_axis_value=0.0,
+        id1="test",
+        id2="case 0",
+        id3=name,
+        id4="coal",
+        id5="",
+        func_type=1,
+        rsp_ent_name=name,
+        rsp_node=node,
+        rsp_dir=3,
+        ref_ent_name="none",
+        ord_data_type=4,
+        num_pts=len(data),
+        abscissa_spacing=1,
+        abscissa_min=0.0,
+        abscissa_inc=1.0 / fs,
+        abscissa_spec_data_type=17,
+        abscissa_axis_units_lab="s",
+        ordinate_spec_data_type=12,
+        ordinate_len_unit_exp=1,
+        ordinate_axis_units_lab="g",
+        orddenom_axis_units_lab="",
+        z_axis_axis_units_lab="",
+        data=data,
+        x=np.arange(len(data)) / fs,
+        **zeros,
+    )
 
 
 def write_uff(path, x, fs=FS, names=("ax", "ay")):
@@ -377,9 +398,16 @@ def test_a_failure_while_streaming_leaves_nothing(tmp_path, capsys):
     wavfile.write(tmp_path / "quiet.wav", 4000, noise)  # no impact to find
     _labels(tmp_path / "l.csv", [{"file": "quiet.wav", "unit": "m/s^2"}])
     out = tmp_path / "out" / "ds"
-    argv = ["import", str(tmp_path / "quiet.wav"), "--labels", str(tmp_path / "l.csv"),
-            "--out", str(out), "--cut", "impacts", "--length", "0.1", "--threshold", "50"]  # fmt: skip
+    argv = ["import", str(tmp_path / "quiet.wav"), "--labels", str(tmp_path / "l.csv"), "--out",
+            str(out), "--cut", "impacts", "--length", "0.1", "--threshold", "50"]  # fmt: skip
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "no onset" in err
     assert list((tmp_path / "out").iterdir()) == []  # the temporary folder is gone
+
+
+def test_uff_channels_without_names_are_named_by_node(tmp_path):
+    write_uff(tmp_path / "other.uff", _signals(), names=("", "NONE"))
+    rec = open_recording(tmp_path / "other.uff")
+    assert rec.channels == ["ch1", "ch2"]
+    np.testing.assert_allclose(rec.read(0, N), _signals(), atol=1e-12)

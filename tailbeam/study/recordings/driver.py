@@ -103,7 +103,7 @@ def _table(plan, sink):
     table = pd.DataFrame(rows)
     for col in plan.coords:  # numbers stay numbers; text stays text
         if table[col].dtype == object:
-            table[col] = table[col].map(lambda v: "" if v is None else str(v))
+            table[col] = table[col].map(lambda v: "" if pd.isna(v) else str(v))
     return table
 
 
