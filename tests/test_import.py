@@ -411,3 +411,30 @@ def test_uff_channels_without_names_are_named_by_node(tmp_path):
     rec = open_recording(tmp_path / "other.uff")
     assert rec.channels == ["ch1", "ch2"]
     np.testing.assert_allclose(rec.read(0, N), _signals(), atol=1e-12)
+
+
+def test_labels_of_an_export_give_the_case_ids_back(tmp_path, capsys):
+    """The labels.csv beside exported UFF files holds case, case_hash and, for an imported
+    dataset, source_file: one case per file keeps the ids and hashes, the rest is kept as
+    labels_<name>."""
+    for name, sign in (("case_7.uff", 1.0), ("case_3.uff", -1.0)):
+        write_uff(tmp_path / name, sign * _signals())
+    rows = [{"file": "case_7.uff", "label": "coal", "case": 7, "case_hash": "h7",
+             "source_file": "a.wav"},
+            {"file": "case_3.uff", "label": "gangue", "case": 3, "case_hash": "h3",
+             "source_file": "b.wav"}]  # fmt: skip
+    _labels(tmp_path / "labels.csv", rows)
+    files = [str(tmp_path / "case_7.uff"), str(tmp_path / "case_3.uff")]
+    out = tmp_path / "ds"
+    assert (
+        main(["import", *files, "--labels", str(tmp_path / "labels.csv"), "--out", str(out)]) == 0
+    )
+    ds = _open(out)
+    assert list(ds["case"].values) == [7, 3] and list(ds["case_hash"].values) == ["h7", "h3"]
+    assert list(ds["labels_source_file"].values) == ["a.wav", "b.wav"]
+    np.testing.assert_allclose(ds["acceleration"].values[1], -G * _signals(), atol=1e-9)
+    rows[1]["case"] = 7
+    _labels(tmp_path / "labels.csv", rows)
+    argv = ["import", *files, "--labels", str(tmp_path / "labels.csv"), "--out", str(out) + "2"]
+    assert main(argv) == 2
+    assert "labels.csv: case: values must differ" in capsys.readouterr().err

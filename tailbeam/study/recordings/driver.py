@@ -33,28 +33,34 @@ RESAMPLING = (
 class _Sink:
     """Collects the cases and onsets the cutters hand over and stages the signals."""
 
-    def __init__(self, writer: SignalWriter, fs: float):
-        self.writer, self.fs = writer, fs
+    def __init__(self, writer: SignalWriter, plan):
+        self.writer, self.fs, self.plan = writer, plan.fs, plan
         self.cases, self.impacts = [], []
-        self.source = None
+        self.source, self.given, self.file_index = None, "", 0
 
     def new_case(self, start: int) -> int:
-        case = len(self.cases)
+        """The new case's position in the store; its id and hash are the labels' (one case
+        per file, round trip of an export) or the position and a hash of its source."""
+        position = len(self.cases)
         key = f"{self.source.sha256}:{start}:{self.writer.n_time}:{self.fs!r}"
-        row = self.source.row
-        self.cases.append({"case": case, "case_hash": hashlib.sha256(key.encode()).hexdigest(),
-                           "source_file": self.given, "t_source": start / self.fs,
-                           "_row": row})  # fmt: skip
-        return case
+        case_hash = hashlib.sha256(key.encode()).hexdigest()
+        ids = self.plan.case_ids
+        k = self.file_index
+        self.cases.append({
+            "case": ids["labels_case"][k] if "labels_case" in ids else position,
+            "case_hash": ids["labels_case_hash"][k] if "labels_case_hash" in ids else case_hash,
+            "source_file": self.given, "t_source": start / self.fs, "_row": self.source.row,
+        })  # fmt: skip
+        return position
 
     def put(self, case, t0, block) -> None:
         self.writer.put(case, t0, block)
 
-    def impact(self, case, index, onset) -> None:
-        info = self.cases[case]
+    def impact(self, position, index, onset) -> None:
+        info = self.cases[position]
         label = info["_row"].get("label")
         self.impacts.append({
-            "case": case, "case_hash": info["case_hash"], "ball": -1, "index": index,
+            "case": info["case"], "case_hash": info["case_hash"], "ball": -1, "index": index,
             "material": "unknown", "class": None if label is None else str(label),
             "v_in": np.nan, "t_start": onset / self.fs, "partner": "plate",
             "t_source": info["t_source"] + onset / self.fs,
@@ -152,12 +158,12 @@ def run_import(plan, out, command: str, files: list) -> dict:
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.import-", dir=out.parent))
     try:
         writer = SignalWriter(tmp / "dataset.zarr", plan.sensors, plan.n_time, plan.fs)
-        sink = _Sink(writer, plan.fs)
+        sink = _Sink(writer, plan)
         total = sum(s.n_samples / s.rate for s in plan.sources)
         dropped = 0
         with task(f"importing {len(files)} files", total=total, unit="s of record") as bar:
-            for src, given in zip(plan.sources, files, strict=True):
-                sink.source, sink.given = src, given
+            for k, (src, given) in enumerate(zip(plan.sources, files, strict=True)):
+                sink.source, sink.given, sink.file_index = src, given, k
                 dropped += _stream(plan, src, sink, bar)
         if not sink.cases:
             raise InputError("--cut", "impacts: no onset found above --threshold in any file")

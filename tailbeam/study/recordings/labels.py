@@ -4,8 +4,12 @@ Columns: ``file`` (required: the recording's path, relative to the labels file's
 absolute); ``label`` (the class); ``sample_rate`` (Hz), ``unit`` and ``full_scale`` (the
 value, in ``unit``, of an integer WAV file's digital full scale; default 1) fill in what the
 file does not say; ``sensor_x``, ``sensor_y`` (m) place every sensor of the row's cases;
-every other column becomes a coordinate of ``case`` unchanged. Rows are numbered from 1
-after the header, as in error messages (``labels.csv row 3: unit``).
+every other column becomes a coordinate of ``case`` unchanged. A column named like one the
+import writes itself (``case``, ``case_hash``, ``source_file``, ``t_source``, ``sensor``,
+``time``; e.g. in the labels.csv of ``tailbeam export``) is kept as ``labels_<name>``; with
+one case per file, ``labels_case`` and ``labels_case_hash`` become the cases' ids and hashes
+(tailbeam.study.recordings.plan). Rows are numbered from 1 after the header, as in error
+messages (``labels.csv row 3: unit``).
 """
 
 from dataclasses import dataclass
@@ -17,7 +21,8 @@ from tailbeam.errors import InputError
 
 RESERVED = ("file", "sample_rate", "unit", "full_scale", "sensor_x", "sensor_y")
 # coordinates the import writes itself: a labels column may not take their names
-WRITTEN = ("case", "case_hash", "source_file", "source_sha256", "t_source", "sensor", "time")
+WRITTEN = ("case", "case_hash", "source_file", "t_source", "sensor", "time")
+PREFIX = "labels_"  # what a labels column named like one of WRITTEN is kept as
 
 
 @dataclass
@@ -40,7 +45,9 @@ class Row:
 
 
 def read_labels(path) -> tuple:
-    """(rows, coordinate columns) of the labels file at ``path``."""
+    """(rows, coordinate columns) of the labels file at ``path``; InputError (one line) for a
+    file without a ``file`` column, an empty cell in it, a missing file or a file named
+    twice."""
     import pandas as pd
 
     path = Path(path)
@@ -51,9 +58,10 @@ def read_labels(path) -> tuple:
     name = path.name
     if "file" not in table.columns:
         raise InputError(str(path), "needs a 'file' column (see docs/recordings.md)")
-    clash = [c for c in table.columns if c in WRITTEN]
-    if clash:
-        raise InputError(f"{name}: {clash[0]}", "is a name the import writes; rename the column")
+    table = table.rename(columns={c: PREFIX + c for c in WRITTEN})
+    taken = [c for c in table.columns if c.startswith(PREFIX) and c[len(PREFIX) :] not in WRITTEN]
+    if taken:
+        raise InputError(f"{name}: {taken[0]}", f"the prefix {PREFIX!r} is the import's own")
     rows, seen = [], {}
     for i, record in enumerate(table.to_dict("records"), start=1):
         cell = record["file"]
@@ -66,5 +74,4 @@ def read_labels(path) -> tuple:
             raise InputError(f"{name} row {i}: file", f"names the file of row {seen[file]} again")
         seen[file] = i
         rows.append(Row(i, file, record))
-    coords = [c for c in table.columns if c not in RESERVED]
-    return rows, coords, table[coords].dtypes.to_dict()
+    return rows, [c for c in table.columns if c not in RESERVED]

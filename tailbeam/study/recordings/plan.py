@@ -68,6 +68,7 @@ class Plan:
     coords: list  # labels columns that become coordinates of case
     labels_path: Path
     notes: list
+    case_ids: dict = field(default_factory=dict)  # labels column -> one value per source
 
 
 def sha256(path: Path) -> str:
@@ -172,7 +173,7 @@ def build_plan(files, labels, *, sample_rate=None, cut="file", length=None, pre=
         raise InputError("--cut", f"must be one of {', '.join(CUTS)}, got {cut!r}")
     if sample_rate is not None and not sample_rate > 0:
         raise InputError("--sample-rate", f"must be > 0 Hz, got {sample_rate}")
-    rows, coords, _dtypes = read_labels(labels)
+    rows, coords = read_labels(labels)
     name = Path(labels).name
     by_file = {r.file: r for r in rows}
     sources = [_source(str(f), by_file, name) for f in files]
@@ -188,9 +189,33 @@ def build_plan(files, labels, *, sample_rate=None, cut="file", length=None, pre=
     onsets.check(fs)
     n_time, n_pre = _case_length(sources, fs, cut, length, pre, onsets, [str(f) for f in files],
                                  notes)  # fmt: skip
+    ids = _case_ids(sources, coords, cut, name)
     for src in sources:
         src.sha256 = sha256(src.path)
-    return Plan(sources, sensors, fs, cut, n_time, n_pre, onsets, coords, Path(labels), notes)
+    return Plan(sources, sensors, fs, cut, n_time, n_pre, onsets, coords, Path(labels), notes, ids)
+
+
+def _case_ids(sources, coords, cut, labels_name) -> dict:
+    """With one case per file, the labels' ``case`` (unique integers) and ``case_hash``
+    (unique) columns are the cases' ids and hashes; they leave ``coords``."""
+    out = {}
+    if cut != "file":
+        return out
+    for column, kind in (("labels_case", int), ("labels_case_hash", str)):
+        if column not in coords:
+            continue
+        values = []
+        for src in sources:
+            value = src.row.get(column)
+            where = src.row.field(labels_name, column[len("labels_") :])
+            if value is None or (kind is int and float(value) != int(float(value))):
+                raise InputError(where, f"must be {'an integer' if kind is int else 'given'}")
+            values.append(kind(int(float(value))) if kind is int else str(value))
+        if len(set(values)) != len(values):
+            raise InputError(f"{labels_name}: {column[len('labels_') :]}", "values must differ")
+        coords.remove(column)
+        out[column] = values
+    return out
 
 
 def _resampling(sources, fs, notes) -> None:
