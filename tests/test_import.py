@@ -17,6 +17,7 @@ pytest.importorskip("nptdms")
 pytest.importorskip("h5py")
 
 from tailbeam.cli.main import main  # noqa: E402
+from tailbeam.errors import InputError  # noqa: E402
 from tailbeam.study.recordings.onsets import OnsetDetector, OnsetOptions  # noqa: E402
 from tailbeam.study.recordings.readers import open_recording  # noqa: E402
 from tailbeam.study.recordings.resample import Resampler, ratio  # noqa: E402
@@ -97,13 +98,13 @@ def write_uff(path, x, fs=FS, names=("ax", "ay")):
     pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")
 
 
-def write_tdms(path, x, fs=FS):
+def write_tdms(path, x, fs=FS, names=("ax", "ay")):
     from nptdms import ChannelObject, TdmsWriter
 
     props = {"wf_increment": 1.0 / fs, "unit_string": "g"}
     with TdmsWriter(path) as writer:
         writer.write_segment([ChannelObject("acc", n, d, properties=props)
-                              for n, d in zip(("ax", "ay"), x, strict=True)])  # fmt: skip
+                              for n, d in zip(names, x, strict=True)])  # fmt: skip
 
 
 def write_mat(path, x, fs=FS):
@@ -227,7 +228,8 @@ def test_units_resampling_and_provenance(tmp_path, capsys):
     # a 3 kHz CSV in g and a 2 kHz TDMS in g of the same analytic sines
     n3 = 3000
     write_csv(tmp_path / "fast.csv", _signals(n3, 3000.0), fs=3000.0)
-    write_tdms(tmp_path / "slow.tdms", _signals(2000, 2000.0), fs=2000.0)
+    # the TDMS file holds its channels in the other order: they are matched by name
+    write_tdms(tmp_path / "slow.tdms", _signals(2000, 2000.0)[::-1], fs=2000.0, names=("ay", "ax"))
     rows = [{"file": "fast.csv", "label": "coal", "size": 1},
             {"file": "slow.tdms", "label": "gangue", "size": 2}]  # fmt: skip
     _labels(tmp_path / "labels.csv", rows)
@@ -238,6 +240,7 @@ def test_units_resampling_and_provenance(tmp_path, capsys):
     printed = capsys.readouterr()
     assert "sensors: ax, ay" in printed.out
     assert "resampled to 2000 Hz" in printed.err
+    assert "slow.tdms: channels ['ay', 'ax'] taken as sensors ['ax', 'ay']" in printed.err
     ds = _open(out)
     assert ds.attrs["sample_rate_hz"] == 2000.0
     assert ds["acceleration"].shape == (2, 2, 2000)
@@ -438,3 +441,26 @@ def test_labels_of_an_export_give_the_case_ids_back(tmp_path, capsys):
     argv = ["import", *files, "--labels", str(tmp_path / "labels.csv"), "--out", str(out) + "2"]
     assert main(argv) == 2
     assert "labels.csv: case: values must differ" in capsys.readouterr().err
+
+
+def test_mat_and_hdf5_rates_from_a_time_vector_or_a_step(tmp_path):
+    import h5py
+    from scipy.io import savemat
+
+    x = _signals()
+    t = 0.25 + np.arange(N) / FS  # a time vector need not start at 0
+    savemat(tmp_path / "t.mat", {"t": t, "ax": x[0], "ay": x[1], "units": "m/s^2"})
+    with h5py.File(tmp_path / "dt.h5", "w") as h5:
+        for name, values in zip(("ax", "ay"), x, strict=True):
+            h5[name] = values
+            h5[name].attrs["dt"] = 1.0 / FS
+            h5[name].attrs["unit"] = "mm/s^2"
+    for name, unit in (("t.mat", "m/s^2"), ("dt.h5", "mm/s^2")):
+        rec = open_recording(tmp_path / name)
+        assert rec.channels == ["ax", "ay"] and rec.units == [unit, unit]
+        assert rec.sample_rate == pytest.approx(FS, rel=1e-9)
+        np.testing.assert_allclose(rec.read(0, N), x, atol=1e-12)
+    t[500] += 0.5 / FS  # half a step off: not evenly spaced
+    savemat(tmp_path / "t.mat", {"t": t, "ax": x[0], "ay": x[1], "units": "m/s^2"})
+    with pytest.raises(InputError, match="evenly spaced"):
+        open_recording(tmp_path / "t.mat")

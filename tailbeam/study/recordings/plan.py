@@ -152,8 +152,9 @@ def _source(given: str, rows_by_file: dict, labels_name: str) -> Source:
         rec.close()
 
 
-def _match_sensors(sources: list, files: list) -> list:
-    """The first file's channels are the sensors; every file must have the same set."""
+def _match_sensors(sources: list, files: list, notes: list) -> list:
+    """The first file's channels are the sensors; every file must have the same set (a file
+    whose order differs is said in ``notes``)."""
     sensors = sources[0].channels
     for src, given in zip(sources, files, strict=True):
         if sorted(src.channels) != sorted(sensors):
@@ -161,6 +162,8 @@ def _match_sensors(sources: list, files: list) -> list:
                              f"of {files[0]}; every file needs the same channel names")  # fmt: skip
         src.order = [src.channels.index(s) for s in sensors]
         src.factors = src.factors[src.order]
+        if src.order != sorted(src.order):
+            notes.append(f"{given}: channels {src.channels} taken as sensors {sensors}")
     return sensors
 
 
@@ -182,8 +185,8 @@ def build_plan(files, labels, *, sample_rate=None, cut="file", length=None, pre=
         if src.path.resolve() in seen:
             raise InputError(str(f), f"is given twice (also as {seen[src.path.resolve()]})")
         seen[src.path.resolve()] = str(f)
-    sensors = _match_sensors(sources, [str(f) for f in files])
     notes = []
+    sensors = _match_sensors(sources, [str(f) for f in files], notes)
     fs = float(sample_rate) if sample_rate else min(s.rate for s in sources)
     _resampling(sources, fs, notes)
     onsets.check(fs)
