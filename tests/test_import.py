@@ -345,6 +345,8 @@ def _bad_cases(folder):
     raw = (folder / "ok.wav").read_bytes()
     (folder / "cut.wav").write_bytes(raw[: len(raw) - 999])
     write_csv(folder / "ok.csv", x)
+    text = (folder / "ok.csv").read_text()
+    (folder / "cut.csv").write_text(text[: text.rindex(",")])  # the last row cut short
     import pandas as pd
 
     pd.DataFrame({"ax": x[0], "ay": x[1]}).to_csv(folder / "norate.csv", index=False)
@@ -353,16 +355,17 @@ def _bad_cases(folder):
     _labels(folder / "l.csv", [
         {"file": "ok.wav", "unit": "g"}, {"file": "cut.wav", "unit": "g"},
         {"file": "norate.csv", "unit": "g"}, {"file": "mono.wav", "unit": "g"},
-        {"file": "r.xyz", "unit": "g"}])  # fmt: skip
+        {"file": "r.xyz", "unit": "g"}, {"file": "cut.csv"}])  # fmt: skip
     _labels(folder / "badunit.csv", [{"file": "ok.wav", "unit": "furlongs"}])
     _labels(folder / "missing.csv", [{"file": "ok.wav", "unit": "g"}, {"file": "gone.wav"}])
     _labels(folder / "norow.csv", [{"file": "ok.csv"}])
     _labels(folder / "clash.csv", [{"file": "ok.csv", "sample_rate": 1000}])
     f = {n: str(folder / n) for n in ("ok.wav", "cut.wav", "norate.csv", "mono.wav", "r.xyz",
-                                      "ok.csv")}  # fmt: skip
+                                      "ok.csv", "cut.csv")}  # fmt: skip
     lab = {n: str(folder / f"{n}.csv") for n in ("l", "badunit", "missing", "norow", "clash")}
     return {
         "truncated": ([f["cut.wav"], "--labels", lab["l"]], ["cut.wav", "WAV"]),
+        "truncated csv": ([f["cut.csv"], "--labels", lab["l"]], ["cut.csv", "cut short"]),
         "no rate": ([f["norate.csv"], "--labels", lab["l"]], ["norate.csv", "sample_rate"]),
         "unknown unit": ([f["ok.wav"], "--labels", lab["badunit"]], ["row 1: unit", "furlongs"]),
         "row of a missing file": (

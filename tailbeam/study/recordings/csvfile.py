@@ -23,18 +23,20 @@ def _split(header: str):
 
 
 def _count_rows(path: Path, n_columns: int) -> int:
-    """Data rows of the file; refuses a last row with fewer fields than the header (a file
-    cut short)."""
-    rows, last = 0, b""
+    """Data rows of the file (lines after the header, blank ones at the end left out);
+    refuses a last row with fewer fields than the header (a file cut short)."""
+    lines, tail = 0, b""
     with open(path, "rb") as fh:
-        fh.readline()
-        for line in fh:
-            if line.strip():
-                rows += 1
-                last = line
-    if rows and last.count(b",") + 1 != n_columns:
+        for chunk in iter(lambda: fh.read(1 << 22), b""):
+            lines += chunk.count(b"\n")
+            tail = (tail + chunk)[-4096:]
+    body = tail.rstrip(b"\r\n \t")
+    blank_end = tail.count(b"\n") - body.count(b"\n")  # newlines after the last row
+    rows = lines + 1 - blank_end - 1  # lines, plus an unterminated last one, less the header
+    last = body.rsplit(b"\n", 1)[-1]
+    if rows > 0 and last.count(b",") + 1 != n_columns:
         raise InputError(str(path), f"row {rows} has fewer fields than the header (cut short?)")
-    return rows
+    return max(rows, 0)
 
 
 def open_csv(path: Path) -> Recording:

@@ -88,9 +88,13 @@ def _stream(plan, src, sink, bar) -> int:
             for x, start in frames:
                 cutter.frame(x, start, detector.frame(x, start))
 
+        read = 0
         for block in rec.blocks():
             run(framer.push(resampler.push(block[src.order] * src.factors[:, None])))
             bar.update(block.shape[1] / src.rate)
+            read += block.shape[1]
+        if read != src.n_samples:  # e.g. blank lines inside a CSV file
+            raise InputError(str(src.path), f"gave {read} samples, {src.n_samples} expected")
         run(framer.push(resampler.finish()))
         run(framer.finish())
         return getattr(cutter, "dropped", 0)
