@@ -11,26 +11,41 @@ from tailbeam.progress import note
 
 def add_arguments(parser):
     parser.add_argument("files", nargs="+", metavar="FILES", help="recordings to import")
-    parser.add_argument("--labels", required=True, help="CSV: one row per file (file, label, ...)")
-    parser.add_argument("--out", required=True, help="output folder (the dataset)")
     parser.add_argument(
-        "--sample-rate", type=float, default=None, help="common rate, Hz (default: the lowest)"
+        "--labels", required=True, metavar="LABELS.csv", help="one row per file: file, label, ..."
     )
-    parser.add_argument("--cut", default="file", help="file (one case each), fixed or impacts")
-    parser.add_argument("--length", type=float, default=None, help="case length, s")
+    parser.add_argument("--out", required=True, metavar="DIR", help="output folder (the dataset)")
     parser.add_argument(
-        "--pre", type=float, default=0.005, help="impact cases start this long before onset, s"
-    )
+        "--sample-rate", type=float, default=None, metavar="HZ",
+        help="common rate, Hz (default: the lowest file rate)",
+    )  # fmt: skip
     parser.add_argument(
-        "--threshold", type=float, default=8.0, help="onset: envelope over noise floor"
+        "--cut", default="file", help="file (one case per file, default), fixed or impacts"
     )
     parser.add_argument(
-        "--dead-time", type=float, default=0.05, help="onset: shortest time between onsets, s"
-    )
-    parser.add_argument("--smooth", type=float, default=0.0005, help="envelope time constant, s")
+        "--length", type=float, default=None, metavar="S",
+        help="case length, s (required with fixed; default 0.1 with impacts)",
+    )  # fmt: skip
     parser.add_argument(
-        "--floor-window", type=float, default=1.0, help="noise floor: median over this long, s"
-    )
+        "--pre", type=float, default=0.005, metavar="S",
+        help="impact cases start this long before the onset, s (default 0.005)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--threshold", type=float, default=8.0, metavar="X",
+        help="onset: envelope over noise floor to exceed (default 8)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--dead-time", type=float, default=0.05, metavar="S",
+        help="onset: shortest time between onsets, s (default 0.05)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--smooth", type=float, default=0.0005, metavar="S",
+        help="onset: envelope time constant, s (default 0.0005)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--floor-window", type=float, default=1.0, metavar="S",
+        help="onset: noise floor = envelope median over frames this long, s (default 1)",
+    )  # fmt: skip
 
 
 def run(args) -> int:
