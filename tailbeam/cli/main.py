@@ -10,7 +10,7 @@ import argparse
 import sys
 
 from tailbeam._version import __version__
-from tailbeam.cli import export, features, learn, modes, reproduce, simulate, sweep
+from tailbeam.cli import export, features, import_, learn, modes, reproduce, simulate, sweep
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.progress import set_quiet
 
@@ -25,6 +25,7 @@ COMMANDS = {
     "features": (features, "compute signal features of a sweep dataset into features.parquet"),
     "learn": (learn, "cross-validated scikit-learn baseline: how separable coal and gangue are"),
     "export": (export, "write a dataset's signals as UFF 58 files (one per case) and labels.csv"),
+    "import": (import_, "measured recordings (WAV, CSV, UFF, TDMS, MAT, HDF5) into a dataset"),
 }
 
 
@@ -83,6 +84,7 @@ def main(argv=None) -> int:
     if args is None:
         return code
     set_quiet(getattr(args, "quiet", False))
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # the command, for provenance
     try:
         return int(args._run(args) or 0)
     except InputError as err:

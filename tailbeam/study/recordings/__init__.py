@@ -1,0 +1,16 @@
+"""Measured accelerometer recordings into the dataset layout of a sweep (``tailbeam import``).
+
+- ``recording``: what a reader gives: channel names, sample rate and units as the file says
+  them, and the samples block by block;
+- ``wav``, ``csvfile``, ``uff``, ``tdms``, ``matfile``, ``hdf5``: one reader per format, with
+  ``arrays`` (the rule that turns the variables of a MAT or HDF5 file into channels) and
+  ``readers`` (which reader opens which file extension);
+- ``units``: acceleration units and their factors to m/s^2;
+- ``labels``: the labels file, one row per recording;
+- ``resample``: block-wise rational resampling (scipy.signal.resample_poly);
+- ``onsets``: impact onsets, an envelope over a robust noise floor, with a dead time;
+- ``cut``: recordings into cases (one per file, fixed windows, or a window per onset);
+- ``plan``: every check made before anything is written, and what was chosen;
+- ``store``: the dataset written chunk by chunk (dataset.zarr, impacts.parquet, cases.csv);
+- ``driver``: the plan run, file by file, block by block.
+"""
