@@ -283,7 +283,11 @@ BAD = [
      "streams", "array of tables"),
     ("height = 0.05", "height = 0.05\nvelocity = [0.0, 0.0, -80.0]", "streams[1].velocity",
      "penetrate"),
-    ("height = 0.05", "height = 1000.0", "streams[1].height", "penetrate"),
+    # a 600 m fall (106 m/s) needs a plate of 60 m or more to be a plausible height
+    (None, STREAM.replace("height = 0.05", "height = 600.0").replace(
+        "inclination = 15.0", "inclination = 15.0\nsize = [100.0, 100.0, 0.05]"),
+     "streams[1].height", "penetrate"),
+    ("height = 0.05", "height = 1000.0", "streams[1].height", "more than 10 x its size"),
 ]  # fmt: skip
 
 

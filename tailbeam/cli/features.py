@@ -9,14 +9,24 @@ from tailbeam.errors import InputError
 def add_arguments(parser):
     parser.add_argument("dataset", help="a sweep's output folder (with dataset.zarr)")
     parser.add_argument(
-        "--window", default="impact", help="impact (one per impact) or fixed (consecutive)"
+        "--window",
+        default="impact",
+        choices=("impact", "fixed"),
+        help="impact: one window per plate impact; fixed: consecutive windows",
     )
-    parser.add_argument("--length", type=float, default=0.02, help="window length, s")
+    parser.add_argument("--length", type=float, default=0.02, metavar="S", help="window length, s")
     parser.add_argument(
-        "--pre", type=float, default=0.0005, help="impact windows start this long before, s"
+        "--pre",
+        type=float,
+        default=0.0005,
+        metavar="S",
+        help="impact windows start this long before the impact, s",
     )
     parser.add_argument(
-        "--out", default=None, help="output file (default DATASET/features.parquet)"
+        "--out",
+        default=None,
+        metavar="FILE",
+        help="feature table, Parquet (default: DATASET/features.parquet)",
     )
 
 

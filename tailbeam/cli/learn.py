@@ -11,10 +11,24 @@ from tailbeam.errors import InputError
 
 def add_arguments(parser):
     parser.add_argument("dataset", help="a sweep's output folder (with dataset.zarr)")
-    parser.add_argument("--target", default="label", help="label (classes) or gangue_fraction")
-    parser.add_argument("--folds", type=int, default=5, help="grouped cross-validation folds")
-    parser.add_argument("--sensors", default=None, help="comma-separated sensors to use (all)")
-    parser.add_argument("--out", default=None, help="output folder (default DATASET/learn)")
+    parser.add_argument(
+        "--target",
+        default="label",
+        choices=("label", "gangue_fraction"),
+        help="label (classes) or gangue_fraction (regression)",
+    )
+    parser.add_argument(
+        "--folds", type=int, default=5, metavar="K", help="cross-validation folds, grouped by case"
+    )
+    parser.add_argument(
+        "--sensors",
+        default=None,
+        metavar="S1,S2",
+        help="comma-separated sensor names to use (default: every sensor)",
+    )
+    parser.add_argument(
+        "--out", default=None, metavar="DIR", help="output folder (default: DATASET/learn)"
+    )
 
 
 def run(args) -> int:

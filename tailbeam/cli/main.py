@@ -29,6 +29,29 @@ COMMANDS = {
 }
 
 
+DESCRIPTION = (
+    "Simulate coal and gangue striking the tail beam of a mining support, and the "
+    "vibration its sensors measure."
+)
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """Every option's help ends with its default, as ``(default: X)``, unless the help text
+    already gives it or there is none (a flag, an option without a value); choices show as
+    ``{a,b,c}`` (argparse)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        default = action.default
+        if "(default" in text or not action.option_strings:
+            return text
+        if default is None or default is False or default is argparse.SUPPRESS:
+            return text
+        if isinstance(default, (list, tuple)):
+            default = " ".join(str(v) for v in default)
+        return f"{text} (default: {str(default).replace('%', '%%')})"
+
+
 class UsageError(Exception):
     """A command-line argument error, reported as one line (exit 2)."""
 
@@ -49,12 +72,18 @@ def _common_options() -> argparse.ArgumentParser:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="tailbeam", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="tailbeam", description=DESCRIPTION, formatter_class=HelpFormatter)
     parser.add_argument("--version", action="version", version=f"tailbeam {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     common = _common_options()
     for name, (module, help_text) in COMMANDS.items():
-        p = sub.add_parser(name, help=help_text, description=help_text, parents=[common])
+        p = sub.add_parser(
+            name,
+            help=help_text,
+            description=help_text,
+            parents=[common],
+            formatter_class=HelpFormatter,
+        )
         module.add_arguments(p)
         p.set_defaults(_run=module.run)
     return parser

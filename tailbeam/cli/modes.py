@@ -12,7 +12,10 @@ costly to compute (tailbeam.plate.fe.cost, estimated before anything is assemble
 from tailbeam.errors import InputError
 from tailbeam.io.output import atomic_output_dir, check_output_dir, describe
 from tailbeam.physics.bodies import Plate
-from tailbeam.physics.materials import get_material
+from tailbeam.physics.materials import BUILTIN_MATERIALS, get_material
+from tailbeam.plate.export import PNG_MODES
+
+THEORIES = ("auto", "kirchhoff", "mindlin")
 
 # library field names -> the options a user typed (tailbeam.cli renames InputError fields)
 CLI_FIELDS = {
@@ -33,31 +36,54 @@ def add_arguments(parser):
     parser.add_argument(
         "--bc",
         default="SSSS",
-        help="boundary code: C/S/F for the edges left, bottom, right, top "
-        "(x=-a/2, y=-b/2, x=+a/2, y=+b/2); default SSSS",
+        metavar="CODE",
+        help="boundary code: C, S or F for the edges left, bottom, right, top "
+        "(x=-a/2, y=-b/2, x=+a/2, y=+b/2)",
     )
     band = parser.add_mutually_exclusive_group()
     band.add_argument(
-        "--fmax", type=float, default=None, help="modes up to this frequency in Hz (default 10000)"
+        "--fmax",
+        type=float,
+        default=None,
+        metavar="HZ",
+        help="every mode up to this frequency in Hz; not with --count (default: 10000)",
     )
-    band.add_argument("--count", type=int, default=None, help="the first N modes")
-    parser.add_argument("--theory", default="auto", choices=("auto", "kirchhoff", "mindlin"))
+    band.add_argument(
+        "--count",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the first N modes instead of a band; not with --fmax (default: the --fmax band)",
+    )
+    parser.add_argument(
+        "--theory",
+        default="auto",
+        choices=THEORIES,
+        help="plate theory; auto chooses from --accuracy and the plate",
+    )
     parser.add_argument(
         "--divisions",
         type=int,
         default=None,
-        help="structured mesh divisions per side (default: from --accuracy)",
+        metavar="N",
+        help="structured mesh divisions per side; not with --mesh (default: from --accuracy)",
     )
     parser.add_argument(
-        "--mesh", default=None, help="triangular mesh file with edges named left/bottom/right/top"
+        "--mesh",
+        default=None,
+        metavar="FILE",
+        help="triangular mesh file in any format meshio reads (Gmsh .msh, .vtu, .xdmf, ...) "
+        "with its edges named left, bottom, right, top (default: a generated mesh)",
     )
     parser.add_argument(
-        "--accuracy",
-        type=float,
-        default=1e-3,
-        help="target relative frequency error (default 1e-3)",
+        "--accuracy", type=float, default=1e-3, help="target relative frequency error"
     )
-    parser.add_argument("--material", default="carbon_steel", help="built-in material name")
+    parser.add_argument(
+        "--material",
+        default="carbon_steel",
+        choices=tuple(BUILTIN_MATERIALS),
+        help="built-in material",
+    )
     parser.add_argument(
         "--size",
         type=float,
@@ -68,8 +94,10 @@ def add_arguments(parser):
     )
     parser.add_argument("--no-cache", action="store_true", help="neither read nor write cache")
     parser.add_argument("--vtu", action="store_true", help="also write modes.vtu (ParaView)")
-    parser.add_argument("--png", action="store_true", help="also write modes.png (mode shapes)")
-    parser.add_argument("--out", default="out/modes", help="output directory")
+    parser.add_argument(
+        "--png", action="store_true", help=f"also write modes.png (the first {PNG_MODES} modes)"
+    )
+    parser.add_argument("--out", default="out/modes", metavar="DIR", help="output folder")
 
 
 def reference_frequencies(basis):
@@ -162,5 +190,6 @@ def _write(args, basis, refs) -> None:
             names.append("modes.vtu")
         if args.png:
             export.write_png(tmp / "modes.png", basis)
-            names.append("modes.png")
+            shown = min(PNG_MODES, basis.n_modes)
+            names.append(f"modes.png (the first {shown} of {basis.n_modes} modes)")
     print(f"wrote {', '.join(names)} to {args.out}")

@@ -21,7 +21,7 @@ from tailbeam.results.records import EventKind
 
 
 def add_arguments(parser):
-    parser.add_argument("--out", default="out/reproduce", help="output directory")
+    parser.add_argument("--out", default="out/reproduce", metavar="DIR", help="output folder")
 
 
 def format_table(claims) -> str:

@@ -1,4 +1,10 @@
-"""`tailbeam simulate SCENE.toml [--out DIR] [--solver NAME]`: simulate a scene, write results.
+"""`tailbeam simulate SCENE.toml [--out DIR] [--overwrite] [--solver NAME]`: simulate a scene,
+write results.
+
+Without --out the results go to out/<the scene file's stem> (``default_out``): a folder an
+earlier run of the same scene file wrote is replaced, a folder of another scene file (or of
+another command) is refused unless --overwrite. An explicit --out replaces any earlier
+tailbeam output, as it always has.
 
 --solver chooses the solver (``tailbeam.simulation.CHOICES``; default auto), so one scene can
 be run through two solvers and their impacts.csv compared.
@@ -15,9 +21,13 @@ scene and --out are fully validated before the solver runs, and the results repl
 whole (tailbeam.io.output), so DIR never mixes two runs.
 """
 
+import json
+from pathlib import Path
+
 from tailbeam.cachedir import announce_first_compile
 from tailbeam.cli import export
-from tailbeam.io.output import atomic_output_dir, check_output_dir, describe
+from tailbeam.errors import InputError
+from tailbeam.io.output import MANIFEST, atomic_output_dir, check_output_dir, describe
 from tailbeam.progress import task
 
 # Heavy modules (scipy.signal, matplotlib) are imported where they are used, so that
@@ -26,14 +36,24 @@ from tailbeam.progress import task
 
 def add_arguments(parser):
     parser.add_argument("scene", help="scene file (TOML); keys in docs/scene-files.md")
-    parser.add_argument("--out", default="out/simulate", help="output directory")
+    parser.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="output folder (default: out/<SCENE's file name without .toml>)",
+    )
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="without --out: replace out/<name> even when another scene file's run wrote it",
+    )
     parser.add_argument(
         "--solver",
         default="auto",
         metavar="NAME",
-        help="auto (default: the exact single-ball solvers where they can run, else the "
-        "stream solver), single-ball, stream or stream-reference (the slow independent "
-        "reference, rigid plate, <= 20 bodies): run one scene through two to compare them",
+        help="auto (the exact single-ball solvers where they can run, else the stream "
+        "solver), single-ball, stream or stream-reference (the slow independent reference, "
+        "rigid plate, <= 20 bodies): run one scene through two to compare them",
     )
     export.add_export_option(parser, "the sensor records (DIR/uff/)")
 
@@ -86,10 +106,43 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
     return files
 
 
+def default_out(scene_file, overwrite: bool = False) -> Path:
+    """out/<stem of ``scene_file``>, refused (InputError naming --out) when it holds the
+    outputs of another scene file or command, unless ``overwrite``."""
+    out = Path("out") / Path(scene_file).stem
+    writer = _written_by(out)
+    mine = str(Path(scene_file).resolve())
+    if writer is None or writer == mine or overwrite:
+        return out
+    raise InputError(
+        "--out",
+        f"the default folder {str(out)!r} holds the outputs of {writer}, not of {scene_file}; "
+        "give --out DIR, or --overwrite to replace it",
+    )
+
+
+def _written_by(out: Path) -> str | None:
+    """The scene file (absolute path) whose run wrote ``out``, a description of another
+    command's run, or None when ``out`` holds no manifest (check_output_dir judges it)."""
+    try:
+        manifest = json.loads((out / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return None
+    meta = manifest.get("files", {}).get("impacts.json", {})
+    if "scene_file" in meta:
+        return meta["scene_file"]
+    command = str(manifest.get("command", ""))
+    if command.startswith("tailbeam simulate "):  # written before the scene file was recorded
+        return str(Path(command.removeprefix("tailbeam simulate ")).resolve())
+    return f"{command or 'another command'!r}"
+
+
 def run(args) -> int:
     from tailbeam.io.scene_file import load_scene
     from tailbeam.simulation import choose_solver, simulate
 
+    if args.out is None:
+        args.out = str(default_out(args.scene, args.overwrite))
     check_output_dir(args.out)
     scene = load_scene(args.scene)
     solver = choose_solver(scene, args.solver, "--solver")
@@ -104,6 +157,7 @@ def run(args) -> int:
         files = write_results(tmp, scene, result)
         if export.chosen(args):
             files += export.write_run_uff(tmp, args.scene, scene, result)
+        describe(tmp / "impacts.json", scene_file=str(Path(args.scene).resolve()))
     n = len(result.impacts)
     names = ", ".join(f.name for f in files)
     print(f"{args.scene}: {n} impacts; wrote {names} to {args.out}")

@@ -15,13 +15,20 @@ from tailbeam.errors import InputError
 
 def add_arguments(parser):
     parser.add_argument("sweep", help="sweep file (TOML): scene, [axes], repeats, seed")
-    parser.add_argument("--out", default="out/sweep", help="dataset folder (default out/sweep)")
+    parser.add_argument("--out", default="out/sweep", metavar="DIR", help="dataset folder")
     where = parser.add_mutually_exclusive_group()
     where.add_argument(
-        "--workers", type=int, default=None, help="local Dask worker processes (default: cores)"
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="local Dask worker processes (default: one per core)",
     )
     where.add_argument(
-        "--scheduler", default=None, help="address of a running Dask scheduler (tcp://host:port)"
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="address of a running Dask scheduler, tcp://host:port (default: a local cluster)",
     )
     export.add_export_option(parser, "every finished case (DIR/uff/)")
 

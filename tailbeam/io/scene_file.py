@@ -25,6 +25,7 @@ from tailbeam.physics.bodies import Ball, Plate, check_ball_above_plate
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import Material, get_material
 from tailbeam.preflight import check_scene
+from tailbeam.preflight import magnitudes as plausible
 from tailbeam.scene import (
     LABELS,
     ContactSettings,
@@ -107,6 +108,7 @@ def parse_scene(data: dict) -> Scene:
         kwargs["inclination"] = data["plate"]["inclination"]
     if "gravity" in data:
         kwargs["gravity"] = require_nonnegative("gravity", data["gravity"])
+        plausible.check_gravity(kwargs["gravity"])
     incline = InclinedPlate(plate, **kwargs)  # validates plate.inclination
     duration = require_positive("duration", data["duration"])
     balls, labels = _parse_balls(data.get("balls", []), materials, plate, "streams" in data)
@@ -192,6 +194,7 @@ def _parse_materials(value) -> dict:
         _check_keys(field, _table(field, props), MATERIAL_KEYS, required=MATERIAL_KEYS)
         vals = {k: require_real(f"{field}.{k}", props[k]) for k in MATERIAL_KEYS}
         out[name] = Material(name, **vals)
+        plausible.check_material(out[name], field)
     return out
 
 
@@ -222,6 +225,7 @@ def _parse_plate(table: dict, materials: dict):
             require_positive(f"plate.size[{i}]", v)
         kwargs.update(size_x=a, size_y=b, thickness=h)
     plate = Plate(**kwargs)
+    plausible.check_plate(plate)
     modal = None
     if model == "modal":
         m = {}
@@ -260,8 +264,11 @@ def _parse_balls(value, materials: dict, plate: Plate, has_streams: bool) -> tup
             _string(f"{field}.material", t["material"]), materials, field=f"{field}.material"
         )
         radius = require_positive(f"{field}.radius", t["radius"])
+        plausible.check_radius(f"{field}.radius", radius, plate)
         position = require_vector(f"{field}.position", t["position"], 3)
+        plausible.check_height(f"{field}.position", position[2], plate)
         velocity = require_vector(f"{field}.velocity", t.get("velocity", (0.0, 0.0, 0.0)), 3)
+        plausible.check_speed(f"{field}.velocity", velocity)
         ball = Ball(name, material, radius, position, velocity)
         try:
             check_ball_above_plate(ball, plate)
@@ -271,7 +278,8 @@ def _parse_balls(value, materials: dict, plate: Plate, has_streams: bool) -> tup
             raise InputError(
                 f"{field}.position",
                 f"the centre (x, y) = ({position[0]!r}, {position[1]!r}) m must lie over the "
-                f"plate, |x| <= {plate.size_x / 2!r}, |y| <= {plate.size_y / 2!r}",
+                f"plate, |x| <= {plate.size_x / 2!r}, |y| <= {plate.size_y / 2!r}"
+                + _metres_hint(position[0], position[1], plate),
             )
         balls.append(ball)
         labels.append(default_label(ball))
@@ -291,7 +299,17 @@ def _parse_streams(value, incline: InclinedPlate, materials: dict) -> tuple:
         parse_stream,
     )
 
-    return tuple(parse_stream(t, i, incline, materials) for i, t in enumerate(tables, start=1))
+    streams = tuple(parse_stream(t, i, incline, materials) for i, t in enumerate(tables, 1))
+    for s in streams:
+        plausible.check_stream(s, incline.plate)
+    return streams
+
+
+def _metres_hint(x: float, y: float, plate: Plate) -> str:
+    """'; positions are in metres (...)' when (x, y) read as millimetres lies over the plate."""
+    if plate.contains(x / 1000.0, y / 1000.0):
+        return f"; positions are in metres ({x:g} mm = {x / 1000.0:g}, {y:g} mm = {y / 1000.0:g})"
+    return ""
 
 
 def _parse_sensors(value, plate: Plate) -> tuple:

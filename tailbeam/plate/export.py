@@ -127,14 +127,15 @@ def build_modes_figure(basis: ModalBasis, n_modes: int = PNG_MODES):
         ax.set_title(
             f"mode {i + 1}: {basis.frequencies_hz[i]:.1f} Hz\n{labels[i].text()}", fontsize=8
         )
-    fig.suptitle(_heading(basis, width), fontsize=9)
+    fig.suptitle(_heading(basis, width, n), fontsize=9)
     fig.legend(handles=_legend_handles(), loc="outside lower center", ncols=4, fontsize=8)
     return fig
 
 
-def _heading(basis: ModalBasis, width_in: float) -> str:
-    """Title lines: plate, theory, edge conditions, how to read a panel; wrapped to fit a
-    figure ``width_in`` inches wide (at 9 pt, about 14 characters per inch)."""
+def _heading(basis: ModalBasis, width_in: float, shown: int) -> str:
+    """Title lines: which modes are shown (the first ``shown`` of the basis), plate, theory,
+    edge conditions, how to read a panel; wrapped to fit a figure ``width_in`` inches wide
+    (at 9 pt, about 14 characters per inch)."""
     edges = ", ".join(
         f"{edge} {CONDITIONS[c]}" for edge, c in zip(EDGES, basis.boundary, strict=True)
     )
@@ -145,8 +146,11 @@ def _heading(basis: ModalBasis, width_in: float) -> str:
         else "nodal (m, n): 1 + nodal lines crossed along x, along y (a half-wave count, "
         "not a closed-form index)"
     )
+    total = basis.n_modes
+    which = f"first {shown} of {total} modes" if shown < total else f"all {total} modes"
     lines = [
-        f"{basis.boundary} plate {plate.size_x:g} x {plate.size_y:g} x {plate.thickness:g} m, "
+        f"{which}: {basis.boundary} plate {plate.size_x:g} x {plate.size_y:g} x "
+        f"{plate.thickness:g} m, "
         f"{basis.theory} ({basis.info.get('element', '')})",
         f"edges: {edges}",
         "x to the right, y up; colour: deflection (red +, blue -), black: nodal lines",

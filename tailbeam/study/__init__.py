@@ -26,5 +26,7 @@ def require_study_dependencies() -> None:
     if missing:
         raise InputError(
             "dependencies",
-            f"{', '.join(missing)} not installed; install them with pip install 'tailbeam[study]'",
+            f"{', '.join(missing)} not installed; they come with the study extra: "
+            "pip install 'tailbeam[study]' from a package index, or from a checkout of "
+            "tailbeam (the folder with pyproject.toml) pip install -e '.[study]'",
         )

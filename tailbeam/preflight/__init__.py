@@ -17,6 +17,10 @@ Rules (and why):
   0 at 280 (the impact ends at rest inside the contact); larger values change nothing
   physical and only drive the contact integrator's step below machine resolution (1e300
   ended in "step size underflow").
+- Magnitudes (``tailbeam.preflight.magnitudes``): values a unit slip makes 1000 times too
+  large or too small (a 30 m ball, 2000 m/s) are refused with the unit probably meant.
+- Overlaps (``tailbeam.preflight.overlaps``): bodies may touch at release but not overlap
+  (ball-ball, stream particles against balls), found with k-d trees in O(n log n).
 - Output size: timeseries.csv rows x columns and every sensor's samples are bounded
   (``MAX_TIMESERIES_VALUES``, ``MAX_SENSOR_SAMPLES``); a sensor needs ``MIN_SENSOR_SAMPLES``
   over the duration for a spectrum.
@@ -147,7 +151,14 @@ def _check_particle_count(scene, max_particles, solver, from_streams: float, ver
 
 def check_scene(scene) -> None:
     """Every preflight rule; raises InputError (or WorkLimitError) on the first broken one."""
+    from tailbeam.preflight.magnitudes import check_magnitudes
+    from tailbeam.preflight.overlaps import check_ball_pairs, check_particles_against_balls
+
+    check_magnitudes(scene)
+    check_ball_pairs(scene.balls)
     check_contacts(scene)
     check_outputs(scene)
     if scene.needs_stream_solver:
         check_streams(scene)
+    if scene.streams:
+        check_particles_against_balls(scene)
