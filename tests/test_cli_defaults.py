@@ -124,7 +124,7 @@ def test_every_option_shows_its_default_and_choices(command):
             continue
         name = action.option_strings[-1]
         helptext = " ".join(sub._get_formatter()._get_help_string(action).split())
-        assert "(default" in helptext, f"{command} {name}: {helptext}"
+        assert "(default" in helptext or "(required)" in helptext, f"{command} {name}: {helptext}"
         if action.default is not None:
             shown = action.default
             if isinstance(shown, (list, tuple)):

@@ -237,7 +237,7 @@ def test_export_command_rewrites_the_same_files(swept, tmp_path, capsys):
 def test_export_bad_input_is_one_line_and_writes_nothing(swept, tmp_path, capsys):
     out = tmp_path / "x"
     code = main(["export", str(swept), "--format", "uff", "--out", str(out)])
-    one_line_error(code, capsys.readouterr().err, "error: --format: unknown format 'uff'")
+    one_line_error(code, capsys.readouterr().err, "argument --format: invalid choice: 'uff'")
     code = main(["export", str(tmp_path / "nope"), "--out", str(out)])
     one_line_error(code, capsys.readouterr().err, "error: DATASET: no dataset.zarr")
     code = main(["sweep", "s.toml", "--export", "uff58,sep"])

@@ -79,10 +79,8 @@ def write_run_uff(out_dir: Path, scene_path, scene, result) -> list:
 
 def add_arguments(parser):
     parser.add_argument("dataset", help="a dataset folder (it holds dataset.zarr)")
-    parser.add_argument(
-        "--format", default="uff58", help=f"file format: {', '.join(FORMATS)} (default uff58)"
-    )
-    parser.add_argument("--out", default=None, help="export folder (default DATASET/uff)")
+    parser.add_argument("--format", default="uff58", choices=FORMATS, help="file format")
+    parser.add_argument("--out", default=None, help="export folder (default: DATASET/uff)")
 
 
 def run(args) -> int:

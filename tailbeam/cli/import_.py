@@ -20,31 +20,34 @@ def add_arguments(parser):
         help="common rate, Hz (default: the lowest file rate)",
     )  # fmt: skip
     parser.add_argument(
-        "--cut", default="file", help="file (one case per file, default), fixed or impacts"
+        "--cut",
+        default="file",
+        choices=("file", "fixed", "impacts"),
+        help="one case per file, fixed windows, or a window per detected impact onset",
     )
     parser.add_argument(
         "--length", type=float, default=None, metavar="S",
-        help="case length, s (required with fixed; default 0.1 with impacts)",
+        help="case length, s (default: required with fixed, 0.1 with impacts)",
     )  # fmt: skip
     parser.add_argument(
         "--pre", type=float, default=0.005, metavar="S",
-        help="impact cases start this long before the onset, s (default 0.005)",
+        help="impact cases start this long before the onset, s",
     )  # fmt: skip
     parser.add_argument(
         "--threshold", type=float, default=8.0, metavar="X",
-        help="onset: envelope over noise floor to exceed (default 8)",
+        help="onset: envelope over noise floor to exceed",
     )  # fmt: skip
     parser.add_argument(
         "--dead-time", type=float, default=0.05, metavar="S",
-        help="onset: shortest time between onsets, s (default 0.05)",
+        help="onset: shortest time between onsets, s",
     )  # fmt: skip
     parser.add_argument(
         "--smooth", type=float, default=0.0005, metavar="S",
-        help="onset: envelope time constant, s (default 0.0005)",
+        help="onset: envelope time constant, s",
     )  # fmt: skip
     parser.add_argument(
         "--floor-window", type=float, default=1.0, metavar="S",
-        help="onset: noise floor = envelope median over frames this long, s (default 1)",
+        help="onset: noise floor = envelope median over frames this long, s",
     )  # fmt: skip
 
 

@@ -36,15 +36,17 @@ DESCRIPTION = (
 
 
 class HelpFormatter(argparse.HelpFormatter):
-    """Every option's help ends with its default, as ``(default: X)``, unless the help text
-    already gives it or there is none (a flag, an option without a value); choices show as
-    ``{a,b,c}`` (argparse)."""
+    """Every option's help ends with its default, as ``(default: X)``, or ``(required)``,
+    unless the help text already gives it or there is none (a flag, an option without a
+    value); choices show as ``{a,b,c}`` (argparse)."""
 
     def _get_help_string(self, action):
         text = action.help or ""
         default = action.default
-        if "(default" in text or not action.option_strings:
+        if "(default" in text or "(required)" in text or not action.option_strings:
             return text
+        if action.required:
+            return f"{text} (required)"
         if default is None or default is False or default is argparse.SUPPRESS:
             return text
         if isinstance(default, (list, tuple)):
