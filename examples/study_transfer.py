@@ -98,19 +98,19 @@ def samples(folder, name: str, model: str, noise_rms: float = 0.0) -> Samples:
     return Samples(meta, windows, sensors, fs, name)
 
 
-def main(quick: bool = True, out="out/study_transfer", workers=None, client=None) -> list:
-    """Run the four sweeps, then every model; returns the rows (also in DIR/transfer.csv)."""
+def main(
+    quick: bool = True, out="out/study_transfer", workers=None, client=None, sweep=True
+) -> list:
+    """Run the four sweeps (``sweep``; else take the datasets in ``out`` as they are), then
+    every model; returns the rows (also in DIR/transfer.csv)."""
     mode = QUICK if quick else FULL
     out = Path(out)
     folders = {}
     for name, table in designs(mode).items():
         folders[name] = out / name
-        run_sweep(
-            parse_sweep(table),
-            folders[name],
-            workers=workers or (1 if quick else None),
-            client=client,
-        )
+        if sweep:
+            workers = workers or (1 if quick else None)
+            run_sweep(parse_sweep(table), folders[name], workers=workers, client=client)
     rows = []
     for model in mode["models"]:
         rows += transfer_rows(folders, model, mode["folds"])
