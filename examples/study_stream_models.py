@@ -35,7 +35,7 @@ from tailbeam.study.windows import feature_table, window_table  # noqa: E402
 
 SENSORS = (("S1", (0.1, 0.0)), ("S2", (-0.15, 0.15)), ("S3", (0.2, -0.2)))
 SENSOR_SETS = {"S1": ["S1"], "S1+S2+S3": ["S1", "S2", "S3"]}
-CASES = 30  # full mode (study 2 itself has 100 per condition; this is what the shared machine allowed)
+CASES = 30  # full mode (study 2 itself has 100 per condition)
 SNR_DB = (math.inf, 0.0)
 
 

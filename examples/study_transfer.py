@@ -181,29 +181,34 @@ def visualize(rows: list, path) -> Path:
 
     mine = [r for r in rows if math.isinf(r["snr_db"])]
     groups = sorted({(r["model"], r["sensors"], r["training"], r["normalise"]) for r in mine})
-    tested = ("nominal", "h12", "cccc")
-    colours = {"nominal": "tab:blue", "h12": "tab:orange", "cccc": "tab:green"}
-    fig, ax = plt.subplots(figsize=(9.5, 5.2), constrained_layout=True)
+    colours = {"nominal": "tab:blue", "randomised": "tab:purple", "h12": "tab:orange",
+               "cccc": "tab:green"}  # fmt: skip
+    fig, ax = plt.subplots(figsize=(12.0, 5.4), constrained_layout=True)
+    width, seen = 0.2, set()
     for i, g in enumerate(groups):
-        for j, t in enumerate(tested):
-            r = next(r for r in mine if (r["model"], r["sensors"], r["training"],
-                                         r["normalise"], r["tested_on"]) == (*g, t))  # fmt: skip
-            hatch = "//" if r["cross_validated"] else None
-            ax.bar(i + (j - 1) * 0.27, r["accuracy"], 0.27, color=colours[t], hatch=hatch,
-                   edgecolor="white", label=t if i == 0 else None)  # fmt: skip
+        bars = [r for r in mine if (r["model"], r["sensors"], r["training"], r["normalise"]) == g]
+        bars.sort(key=lambda r: list(colours).index(r["tested_on"]))
+        for j, r in enumerate(bars):
+            t = r["tested_on"]
+            label = f"{t} (grouped CV)" if r["cross_validated"] else t
+            ax.bar(i + (j - (len(bars) - 1) / 2) * width, r["accuracy"], width,
+                   color=colours[t], hatch="//" if r["cross_validated"] else None,
+                   edgecolor="white", label=None if label in seen else label)  # fmt: skip
+            seen.add(label)
     ax.axhline(0.5, color="k", ls="--", lw=1, label="majority class (0.50)")
-    names = [f"{m}\n{s}\n{tr}{', norm.' if n else ''}" for m, s, tr, n in groups]
-    ax.set_xticks(range(len(groups)), names, fontsize=6.5)
-    ax.set_ylim(0.3, 1.0)
+    names = [f"{m}\n{s}\n{tr[:4]}.{' norm.' if n else ''}" for m, s, tr, n in groups]
+    ax.set_xticks(range(len(groups)), names, fontsize=7)
+    ax.set_ylim(0.3, 0.9)
     ax.set_ylabel("accuracy (hatched: grouped CV on the training set)")
     n = {r["tested_on"]: int(r["n_cases"]) for r in mine}
     ax.set_title(
-        "coal vs sandstone, first impacts: trained on the 10 mm SSSS plate (nominal) or a "
-        f"randomised set,\ntested on 12 mm SSSS (h12, {n['h12']} cases) and 10 mm CCCC "
-        f"(cccc, {n['cccc']} cases); nominal {n['nominal']} cases",
+        "coal vs sandstone, first impacts: trained on the 10 mm SSSS plate (nomi.) or the "
+        f"randomised set (rand., {n.get('randomised', 0)} cases),\ntested on 12 mm SSSS (h12, "
+        f"{n['h12']} cases), 10 mm CCCC (cccc, {n['cccc']} cases) and the nominal set "
+        f"({n['nominal']} cases); norm.: --normalise",
         fontsize=9,
     )
-    ax.legend(fontsize=7, ncol=4, loc="upper right")
+    ax.legend(fontsize=7, ncol=3, loc="upper right")
     ax.grid(axis="y", alpha=0.3)
     fig.savefig(path, dpi=120)
     plt.close(fig)
