@@ -13,14 +13,16 @@ same design on a 12 mm plate (``h12``) and on the 10 mm plate clamped on all edg
 (0.3-5 %, log-uniform), the contact damping (30-3000 N s/m, log-uniform), each sensor's
 mounted resonance (7-25 kHz) and white noise floor (0-300 m/s^2 RMS), and a wider size and
 speed distribution (radius 7-140 mm log-uniform, 0.5-6 m/s); its plate stays the nominal one.
+A second one (``plates``, 150 cases per class) draws the plate too: thickness 8, 11 or 14 mm,
+edges SSSS or CSCS (clamped left and right), neither test plate among them.
 
 Windows: 20 ms from 0.5 ms before each ball's first impact, no added noise (the randomised set
 holds its own noise). Each model is scored by 5-fold cross-validation grouped by case on its
 training set, then fitted on all of it and scored on the other sets, beside the majority class
 of the training set. Separability of simulated signals under this model, not field accuracies.
 
-Quick mode (the tests run it): 6 cases per class to train, 4 per class to test, 3 folds,
-the forest only.
+Quick mode (the tests run it): 6 cases per class to train (4 for ``plates``), 4 per class to
+test, 3 folds, the forest only.
 """
 
 import argparse
@@ -43,11 +45,15 @@ from tailbeam.study.windows import feature_table, window_table  # noqa: E402
 
 SENSORS = (("S1", (0.1, 0.15)), ("S2", (-0.15, 0.05)), ("S3", (0.05, -0.2)))
 SENSOR_SETS = {"S1": ["S1"], "S1+S2+S3": ["S1", "S2", "S3"]}
-FULL = {"train": 200, "test": 100, "folds": 5, "models": ("forest", "minirocket")}
-QUICK = {"train": 6, "test": 4, "folds": 3, "models": ("forest",)}
+FULL = {"train": 200, "test": 100, "plates": 150, "folds": 5, "models": ("forest", "minirocket")}
+QUICK = {"train": 6, "test": 4, "plates": 4, "folds": 3, "models": ("forest",)}
+PLATE_THICKNESSES = [0.008, 0.011, 0.014]  # m
+PLATE_BOUNDARIES = ["SSSS", "CSCS"]
 WINDOWS = {"window": "impact", "length": WINDOW_S, "pre": 0.0005, "first_only": True}
 SNR_DB = 10.0  # study 1 by model and sensors: also at this SNR (and without added noise)
-TESTS = {"train": ("h12", "cccc"), "randomised": ("nominal", "h12", "cccc")}
+TRAINING = {"nominal": "train", "randomised": "train_randomised", "plates": "train_plates"}
+TESTS = {"nominal": ("h12", "cccc"), "randomised": ("nominal", "h12", "cccc"),
+         "plates": ("nominal", "h12", "cccc")}  # fmt: skip
 
 
 def plate_variant(scene: dict, thickness=None, boundary=None) -> dict:
@@ -78,6 +84,19 @@ def randomised(table: dict, samples: int) -> dict:
     return {**table, "axes": axes}
 
 
+def plate_randomised(table: dict, samples: int) -> dict:
+    """``randomised(table)`` with the plate drawn too: thickness and edge conditions (neither
+    the 12 mm nor the clamped plate of the test sets among them)."""
+
+    def choice(values):
+        return {"distribution": "choice", "values": values, "samples": samples}
+
+    out = randomised(table, samples)
+    out["axes"]["plate.size[2]"] = choice(PLATE_THICKNESSES)
+    out["axes"]["plate.boundary"] = choice(PLATE_BOUNDARIES)
+    return out
+
+
 def designs(mode: dict) -> dict:
     """Folder name -> sweep table of the four datasets."""
     n, m = mode["train"], mode["test"]
@@ -86,6 +105,10 @@ def designs(mode: dict) -> dict:
         "test_h12": sweep_table(m, plate_variant(base_scene(SENSORS), thickness=0.012), seed=11),
         "test_cccc": sweep_table(m, plate_variant(base_scene(SENSORS), boundary="CCCC"), seed=12),
         "train_randomised": randomised(sweep_table(n, base_scene(SENSORS), seed=13), n),
+        "train_plates": plate_randomised(
+            sweep_table(mode["plates"], plate_variant(base_scene(SENSORS), 0.01), seed=14),
+            mode["plates"],
+        ),
     }
 
 
@@ -136,24 +159,22 @@ def _row(model, sensors, training, normalise, tested, s, cv=False) -> dict:
     }
 
 
-def transfer_rows(folders: dict, model: str, folds: int) -> list:
-    """Each training set (nominal, randomised) x sensor set x normalise: its grouped CV score
-    and its scores on the other sets."""
-    data = {
-        name: samples(folders[key], name, model)
-        for name, key in (("nominal", "train"), ("randomised", "train_randomised"),
-                          ("h12", "test_h12"), ("cccc", "test_cccc"))
-    }  # fmt: skip
+def transfer_rows(folders: dict, model: str, folds: int, trainings=tuple(TESTS)) -> list:
+    """Each training set of ``trainings`` x sensor set x normalise: its grouped CV score and
+    its scores on the other sets."""
+    keys = {**TRAINING, "h12": "test_h12", "cccc": "test_cccc"}
+    data = {name: samples(folders[key], name, model) for name, key in keys.items()}
     rows = []
-    for training, tests in TESTS.items():
-        train = data["nominal" if training == "train" else "randomised"]
+    for training in trainings:
+        train = data[training]
         for label, sensors in SENSOR_SETS.items():
             for normalise in (False, True):
                 s = learn(train, folds=folds, sensors=sensors, model=model,
-                          normalise=normalise, test=[data[t] for t in tests])  # fmt: skip
-                name = "nominal" if training == "train" else "randomised"
-                rows.append(_row(model, label, name, normalise, name, s, cv=True))
-                rows += [_row(model, label, name, normalise, t["dataset"], t) for t in s["test"]]
+                          normalise=normalise, test=[data[t] for t in TESTS[training]])  # fmt: skip
+                rows.append(_row(model, label, training, normalise, training, s, cv=True))
+                rows += [
+                    _row(model, label, training, normalise, t["dataset"], t) for t in s["test"]
+                ]
     return rows
 
 
@@ -181,8 +202,8 @@ def visualize(rows: list, path) -> Path:
 
     mine = [r for r in rows if math.isinf(r["snr_db"])]
     groups = sorted({(r["model"], r["sensors"], r["training"], r["normalise"]) for r in mine})
-    colours = {"nominal": "tab:blue", "randomised": "tab:purple", "h12": "tab:orange",
-               "cccc": "tab:green"}  # fmt: skip
+    colours = {"nominal": "tab:blue", "randomised": "tab:purple", "plates": "tab:brown",
+               "h12": "tab:orange", "cccc": "tab:green"}  # fmt: skip
     fig, ax = plt.subplots(figsize=(12.0, 5.4), constrained_layout=True)
     width, seen = 0.2, set()
     for i, g in enumerate(groups):

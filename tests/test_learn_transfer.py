@@ -127,11 +127,13 @@ def test_refuses_another_dataset_without_the_sensors(sets, tmp_path, capsys):
     out = tmp_path / "never"
     code = main(["learn", str(sets["train"]), "--test", str(sets["other"]), "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1 and "--test" in err[0] and "'S1." in err[0]
+    assert code == 2 and len(err) == 1 and "--test" in err[0] and "'S1'" in err[0]
     assert not out.exists()
     table = feature_table(sets["train"])
     with pytest.raises(InputError, match="--test.*'label'"):
         learn(table, folds=3, test=Samples(table.drop(columns="label"), name="OTHER"))
+    with pytest.raises(InputError, match="--test.*'S2.kurtosis'"):
+        learn(table, folds=3, test=Samples(table.drop(columns="S2.kurtosis"), name="OTHER"))
 
 
 def test_minirocket_reads_the_windows_the_features_are_computed_of(sets):

@@ -77,8 +77,8 @@ def test_transfer_study_quick(tmp_path, client):
     rows = module.main(quick=True, out=tmp_path, client=client)
     cv = [r for r in rows if r["cross_validated"] and math.isinf(r["snr_db"])]
     tests = [r for r in rows if not r["cross_validated"]]
-    # two training sets x two sensor sets x normalise or not; 2 + 3 test sets each
-    assert len(cv) == 8 and len(tests) == 4 * 2 + 4 * 3
+    # three training sets x two sensor sets x normalise or not; 2, 3 and 3 test sets
+    assert len(cv) == 12 and len(tests) == 4 * 2 + 4 * 3 + 4 * 3
     assert {r["tested_on"] for r in tests} == {"nominal", "h12", "cccc"}
     assert all(r["n_cases"] == 8 for r in tests if r["tested_on"] != "nominal")
     assert [r["snr_db"] for r in rows if r["cross_validated"]][-2:] == [10.0, 10.0]

@@ -40,10 +40,16 @@ def run(args) -> int:
     from tailbeam.study.learn import learn
     from tailbeam.study.windows import open_dataset
 
-    _ds, folder = open_dataset(args.dataset)
+    ds, folder = open_dataset(args.dataset)
+    sensors = args.sensors.split(",") if args.sensors else None
+    if args.test:  # before any window is cut: OTHER records every sensor the model reads
+        other = {str(s) for s in open_dataset(args.test)[0]["sensor"].values}
+        needed = sensors or [str(s) for s in ds["sensor"].values]
+        missing = [s for s in needed if s not in other]
+        if missing:
+            raise InputError("--test", f"{args.test} has no sensor {missing[0]!r} (TRAIN's)")
     train, settings = _samples(args.dataset, args.model, None, "TRAIN")
     test = _samples(args.test, args.model, settings, args.test)[0] if args.test else None
-    sensors = args.sensors.split(",") if args.sensors else None
     scores = learn(
         train, args.target, folds=args.folds, sensors=sensors, model=args.model,
         normalise=args.normalise, test=test,

@@ -126,9 +126,11 @@ class _Inputs:
             if missing:
                 raise InputError("--test", f"{other.name} has no column {missing[0]!r} (TRAIN's)")
             return
+        if other.windows is None:
+            raise InputError("--test", f"{other.name}: minirocket needs its raw windows")
         missing = [s for s in self.sensors if s not in other.sensors]
-        if other.windows is None or missing:
-            raise InputError("--test", f"{other.name} has no sensor {missing[:1] or 'windows'}")
+        if missing:
+            raise InputError("--test", f"{other.name} has no sensor {missing[0]!r} (TRAIN's)")
         same = (other.windows.shape[-1], other.sample_rate) == (self.samples, self.sample_rate)
         if not same:
             raise InputError(
