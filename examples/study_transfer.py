@@ -201,10 +201,14 @@ def visualize(rows: list, path) -> Path:
     import matplotlib.pyplot as plt
 
     mine = [r for r in rows if math.isinf(r["snr_db"])]
-    groups = sorted({(r["model"], r["sensors"], r["training"], r["normalise"]) for r in mine})
+    order = list(TRAINING)
+    groups = sorted(
+        {(r["model"], r["sensors"], r["training"], r["normalise"]) for r in mine},
+        key=lambda g: (g[0], g[1], order.index(g[2]), g[3]),
+    )
     colours = {"nominal": "tab:blue", "randomised": "tab:purple", "plates": "tab:brown",
                "h12": "tab:orange", "cccc": "tab:green"}  # fmt: skip
-    fig, ax = plt.subplots(figsize=(12.0, 5.4), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(max(12.0, 0.6 * len(groups)), 5.6), constrained_layout=True)
     width, seen = 0.2, set()
     for i, g in enumerate(groups):
         bars = [r for r in mine if (r["model"], r["sensors"], r["training"], r["normalise"]) == g]
@@ -217,14 +221,16 @@ def visualize(rows: list, path) -> Path:
                    edgecolor="white", label=None if label in seen else label)  # fmt: skip
             seen.add(label)
     ax.axhline(0.5, color="k", ls="--", lw=1, label="majority class (0.50)")
-    names = [f"{m}\n{s}\n{tr[:4]}.{' norm.' if n else ''}" for m, s, tr, n in groups]
-    ax.set_xticks(range(len(groups)), names, fontsize=7)
+    names = [f"{m}\n{s.replace('S1+S2+S3', '3 sensors')}\n{tr}\n{'norm.' if n else ''}"
+             for m, s, tr, n in groups]  # fmt: skip
+    ax.set_xticks(range(len(groups)), names, fontsize=6.5)
     ax.set_ylim(0.3, 0.9)
     ax.set_ylabel("accuracy (hatched: grouped CV on the training set)")
     n = {r["tested_on"]: int(r["n_cases"]) for r in mine}
     ax.set_title(
-        "coal vs sandstone, first impacts: trained on the 10 mm SSSS plate (nomi.) or the "
-        f"randomised set (rand., {n.get('randomised', 0)} cases),\ntested on 12 mm SSSS (h12, "
+        "coal vs sandstone, first impacts: trained on the 10 mm SSSS plate (nominal), the "
+        f"randomised set (randomised, {n.get('randomised', 0)} cases) or randomised plates "
+        f"(plates, {n.get('plates', 0)} cases),\ntested on 12 mm SSSS (h12, "
         f"{n['h12']} cases), 10 mm CCCC (cccc, {n['cccc']} cases) and the nominal set "
         f"({n['nominal']} cases); norm.: --normalise",
         fontsize=9,
