@@ -9,7 +9,8 @@ Two kinds of window, each a row of the table with one column per sensor and feat
 - ``fixed``: consecutive non-overlapping windows of ``length`` s; the row's ``label`` is the
   case's label (coal | gangue | mixed) and ``gangue_fraction`` the case's.
 Every row also carries ``case`` (for grouped cross-validation), ``window``, ``t_start`` (s),
-the case's labels and swept values.
+the case's labels and swept values. ``window_table`` gives the same rows with the raw windows
+instead of their features (for models that read the signal itself, e.g. MiniRocket).
 """
 
 import numpy as np
