@@ -69,3 +69,30 @@ def test_stream_gangue_fraction_study_quick(tmp_path, client):
     assert all(r["mae"] >= 0.0 and r["count_reference_mae"] >= 0.0 for r in rows)
     assert (tmp_path / "gangue_fraction_vs_snr.csv").is_file()
     assert module.visualize(rows, tmp_path / "f.png").stat().st_size > 0
+
+
+@pytest.mark.slow
+def test_transfer_study_quick(tmp_path, client):
+    module = _load("study_transfer")
+    rows = module.main(quick=True, out=tmp_path, client=client)
+    cv = [r for r in rows if r["cross_validated"] and math.isinf(r["snr_db"])]
+    tests = [r for r in rows if not r["cross_validated"]]
+    # three training sets x two sensor sets x normalise or not; 2, 3 and 3 test sets
+    assert len(cv) == 12 and len(tests) == 4 * 2 + 4 * 3 + 4 * 3
+    assert {r["tested_on"] for r in tests} == {"nominal", "h12", "cccc"}
+    assert all(r["n_cases"] == 8 for r in tests if r["tested_on"] != "nominal")
+    assert [r["snr_db"] for r in rows if r["cross_validated"]][-2:] == [10.0, 10.0]
+    assert all(0.0 <= r["accuracy"] <= 1.0 for r in rows)
+    assert module.visualize(rows, tmp_path / "t.png").stat().st_size > 0
+
+
+def test_stream_models_study_quick(tmp_path, client):
+    module = _load("study_stream_models")
+    rows = module.main(quick=True, out=tmp_path, client=client)
+    assert [(r["sensors"], r["snr_db"]) for r in rows] == [
+        ("S1", math.inf),
+        ("S1+S2+S3", math.inf),
+        ("S1", 0.0),
+        ("S1+S2+S3", 0.0),
+    ]
+    assert all(r["n_cases"] == 6 and r["n_rows"] == 12 for r in rows)

@@ -7,10 +7,12 @@
 - ``dataset``: the on-disk dataset (dataset.zarr, impacts.parquet, cases.csv);
 - ``features``: signal features per window (pure numpy/scipy/PyWavelets functions);
 - ``windows``: impact windows and fixed windows cut from the dataset, and the feature table;
-- ``learn``: scikit-learn baselines with cross-validation grouped by case.
+- ``models``: the models of ``learn`` (random forest on features, MiniRocket on raw windows);
+- ``learn``: their scores, cross-validated grouped by case and on another dataset, with
+  ``learn_figures`` (confusion matrix, importances).
 
-The optional dependencies (dask, xarray, zarr, pyarrow, scikit-learn, PyWavelets) are imported
-inside the functions that need them, so ``import tailbeam`` stays light.
+The optional dependencies (dask, xarray, zarr, pyarrow, scikit-learn, PyWavelets, sktime) are
+imported inside the functions that need them, so ``import tailbeam`` stays light.
 """
 
 STUDY_MODULES = ("dask.distributed", "xarray", "zarr", "pyarrow", "sklearn", "pywt", "pandas")

@@ -29,6 +29,9 @@ SCALAR_FEATURES = (
     "psd_peak_hz",
     "psd_median_hz",
 )
+# the features that scale with the signal (a sensor's gain); every other one is scale-free:
+# a window times g > 0 gives the same value
+SCALE_FEATURES = ("rms", "peak", "energy", "psd_power")
 
 
 def is_feature_name(name: str) -> bool:

@@ -1,104 +1,184 @@
-"""Baselines of how separable the classes are: scikit-learn on the feature table.
+"""Baselines of how separable the classes are: a model scored on windows of a dataset.
 
-The model is a pipeline of a median imputer (for features undefined on a window, e.g. the
-decay rate of a window whose loudest frame is its last), a standard scaler and a random forest
-(classifier for ``label``, regressor for ``gangue_fraction``), scored by cross-validation
-grouped by case (``GroupKFold``): windows of one case never sit in training and test at once, so
-repeated impacts of one ball cannot leak. Beside the model, a majority-class (or mean) dummy
-is scored on the same folds as the floor to compare with. Feature importances are the
-forest's impurity decrease, from a fit on all rows.
+The model (tailbeam.study.models: a random forest on the feature table, or MiniRocket on the
+raw windows) is scored by cross-validation grouped by case (``GroupKFold``): windows of one
+case never sit in training and test at once, so repeated impacts of one ball cannot leak.
+Beside it, a majority-class (or mean) dummy is scored on the same folds as the floor to
+compare with. With ``test``, the model fitted on every row of the training data is also
+scored on another dataset (e.g. another plate), beside the dummy fitted on the same rows.
+The forest's feature importances are its impurity decrease, from that fit on all rows.
 """
+
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from tailbeam.errors import InputError
-from tailbeam.study.features import is_feature_name
+from tailbeam.study import models
 
 TARGETS = ("label", "gangue_fraction")
 
 
-def feature_columns(table, sensors=None) -> list:
-    """Signal-feature columns (``<sensor>.<feature>``), optionally of some sensors only."""
-    cols = []
-    for c in table.columns:
-        sensor, _, name = c.partition(".")
-        if is_feature_name(name) and (sensors is None or sensor in sensors):
-            cols.append(c)
-    return cols
+@dataclass
+class Samples:
+    """Windows of one dataset: ``table`` (one row per window: case, labels, features) and, for
+    MiniRocket, the raw ``windows`` (rows, sensor, samples) in m/s^2 of ``sensors`` at
+    ``sample_rate`` (Hz); ``name`` says where they come from in messages."""
+
+    table: object
+    windows: np.ndarray | None = None
+    sensors: list = field(default_factory=list)
+    sample_rate: float = 0.0
+    name: str = "TRAIN"
 
 
-def _model(classify: bool, seed: int):
-    from sklearn.ensemble import RandomForestClassifier, RandomForestRegressor
-    from sklearn.impute import SimpleImputer
-    from sklearn.pipeline import make_pipeline
-    from sklearn.preprocessing import StandardScaler
+def learn(
+    data, target="label", *, folds=5, seed=0, sensors=None, model="forest", normalise=False,
+    test=None,
+) -> dict:  # fmt: skip
+    """Cross-validated scores of ``model`` and the dummy on ``data`` (Samples, or a feature
+    table for the forest), and with ``test`` (Samples, or a list of them) the scores on it of
+    both fitted on all of ``data``.
 
-    forest = RandomForestClassifier if classify else RandomForestRegressor
-    return make_pipeline(
-        SimpleImputer(strategy="median"),
-        StandardScaler(),
-        forest(n_estimators=200, random_state=seed, n_jobs=1),
-    )
-
-
-def _dummy(classify: bool):
-    from sklearn.dummy import DummyClassifier, DummyRegressor
-
-    return DummyClassifier(strategy="most_frequent") if classify else DummyRegressor()
-
-
-def learn(table, target="label", *, folds=5, seed=0, sensors=None) -> dict:
-    """Cross-validated scores of the model and the dummy on ``table`` (a feature table).
-
-    Returns a dict: target, n_rows, n_cases, folds, features, and for a label "accuracy",
-    "f1_macro", "classes", "confusion" (rows true, columns predicted), or for gangue_fraction
-    "mae", "r2", "mae_se" (standard error of the MAE, cases as the units); "dummy" holds the
-    dummy's scores; "importances" feature -> importance."""
-    from sklearn import metrics
+    Returns a dict: model, normalise, target, n_rows, n_cases, folds, sensors, features, and
+    for a label "accuracy", "f1_macro", "classes", "confusion" (rows true, columns
+    predicted), or for gangue_fraction "mae", "r2", "mae_se" (standard error of the MAE,
+    cases as the units); "dummy" holds the dummy's scores; "importances" feature ->
+    importance (forest; empty for MiniRocket); "test" the same scores on ``test`` (with its
+    dataset, n_rows, n_cases; a list of them for a list)."""
     from sklearn.model_selection import GroupKFold, cross_val_predict
 
-    if target not in TARGETS:
-        raise InputError("--target", f"must be one of {TARGETS}, got {target!r}")
-    if target not in table.columns:
-        raise InputError("--target", f"the feature table has no column {target!r}")
-    cols = feature_columns(table, sensors)
-    # an undefined feature (e.g. no decay after the peak) is imputed, never a dropped row
-    table = table.replace([np.inf, -np.inf], np.nan).dropna(subset=[target])
-    groups = table["case"].to_numpy()
+    data = data if isinstance(data, Samples) else Samples(data)
+    if model not in models.MODELS:
+        raise InputError("--model", f"must be one of {models.MODELS}, got {model!r}")
+    _check_target(data, target)
+    inputs = _Inputs(model, data, sensors, normalise)
+    tests = [] if test is None else test if isinstance(test, list | tuple) else [test]
+    for other in tests:
+        _check_target(other, target, "--test")
+        inputs.check(other)
+    keep = data.table[target].notna().to_numpy()
+    x, y = inputs.x(data, keep), data.table[target].to_numpy()[keep]
+    groups = data.table["case"].to_numpy()[keep]
     n_cases = len(np.unique(groups))
     if n_cases < folds:
         raise InputError("--folds", f"needs at least {folds} cases, the dataset has {n_cases}")
-    x = table[cols].to_numpy(float)
-    y = table[target].to_numpy()
     classify = target == "label"
     if classify and len(np.unique(y)) < 2:
         raise InputError("--target", f"needs two classes or more, found only {np.unique(y)}")
     cv = GroupKFold(n_splits=folds)
-    pred = cross_val_predict(_model(classify, seed), x, y, groups=groups, cv=cv)
-    floor = cross_val_predict(_dummy(classify), x, y, groups=groups, cv=cv)
+    pred = cross_val_predict(models.make(model, classify, seed), x, y, groups=groups, cv=cv)
+    floor = cross_val_predict(models.dummy(classify), x, y, groups=groups, cv=cv)
     out = {
+        "model": model,
+        "normalise": bool(normalise),
         "target": target,
         "n_rows": len(y),
         "n_cases": n_cases,
         "folds": folds,
-        "features": cols,
+        "sensors": inputs.sensors,
+        "features": inputs.names,
+        **_scores(classify, y, pred, floor, groups),
+        "importances": {},
     }
-    if classify:
-        classes = sorted(np.unique(y))
-        out.update(_class_scores(metrics, y, pred, classes))
-        out["dummy"] = _class_scores(metrics, y, floor, classes)
-        out["dummy"].pop("confusion")
-    else:
-        out.update(_reg_scores(metrics, y, pred), mae_se=_case_se(np.abs(pred - y), groups))
-        out["dummy"] = _reg_scores(metrics, y, floor)
-        out["dummy"]["mae_se"] = _case_se(np.abs(floor - y), groups)
-    forest = _model(classify, seed).fit(x, y)[-1]
-    order = np.argsort(forest.feature_importances_)[::-1]
-    out["importances"] = {cols[i]: float(forest.feature_importances_[i]) for i in order}
+    if model == "forest" or tests:
+        fitted = models.make(model, classify, seed).fit(x, y)
+        if model == "forest":
+            out["importances"] = _importances(fitted[-1], inputs.names)
+        scored = [_test_scores(t, target, inputs, fitted, x, y, classify) for t in tests]
+        if scored:
+            out["test"] = scored if isinstance(test, list | tuple) else scored[0]
     return out
 
 
-def _class_scores(metrics, y, pred, classes) -> dict:
+def _check_target(samples, target, field="--target"):
+    if target not in TARGETS:
+        raise InputError("--target", f"must be one of {TARGETS}, got {target!r}")
+    if target not in samples.table.columns:
+        where = "the feature table" if field == "--target" else f"{samples.name}"
+        raise InputError(field, f"{where} has no column {target!r} (the target)")
+
+
+class _Inputs:
+    """What the model reads of a Samples: feature columns (forest) or sensor channels."""
+
+    def __init__(self, model, data, sensors, normalise):
+        self.model, self.normalise = model, normalise
+        if model == "forest":
+            self.names = models.feature_columns(data.table, sensors, scale_free=normalise)
+            if not self.names:
+                raise InputError("--sensors", f"no feature columns of sensors {sensors}")
+            self.sensors = sorted({c.partition(".")[0] for c in self.names})
+            return
+        if data.windows is None:
+            raise InputError("--model", "minirocket needs the raw windows (Samples.windows)")
+        self.sensors = list(sensors) if sensors else list(data.sensors)
+        missing = [s for s in self.sensors if s not in data.sensors]
+        if missing:
+            raise InputError("--sensors", f"{data.name} has no sensor {missing[0]!r}")
+        self.names = list(self.sensors)
+        self.samples, self.sample_rate = data.windows.shape[-1], data.sample_rate
+
+    def check(self, other):
+        """InputError naming what ``other`` lacks that the model reads."""
+        if self.model == "forest":
+            missing = [c for c in self.names if c not in other.table.columns]
+            if missing:
+                raise InputError("--test", f"{other.name} has no column {missing[0]!r} (TRAIN's)")
+            return
+        if other.windows is None:
+            raise InputError("--test", f"{other.name}: minirocket needs its raw windows")
+        missing = [s for s in self.sensors if s not in other.sensors]
+        if missing:
+            raise InputError("--test", f"{other.name} has no sensor {missing[0]!r} (TRAIN's)")
+        same = (other.windows.shape[-1], other.sample_rate) == (self.samples, self.sample_rate)
+        if not same:
+            raise InputError(
+                "--test",
+                f"{other.name}'s windows are {other.windows.shape[-1]} samples at "
+                f"{other.sample_rate:g} Hz, TRAIN's {self.samples} at {self.sample_rate:g} Hz",
+            )
+
+    def x(self, samples, keep):
+        """The model's input of the rows ``keep`` of ``samples``."""
+        if self.model == "forest":
+            x = samples.table[self.names].to_numpy(float)[keep]
+            # an undefined feature (e.g. no decay after the peak) is imputed, never a dropped row
+            return np.where(np.isfinite(x), x, np.nan)
+        idx = [samples.sensors.index(s) for s in self.sensors]
+        w = samples.windows[keep][:, idx, :]
+        return models.normalised(w) if self.normalise else np.asarray(w, dtype=float)
+
+
+def _scores(classify, y, pred, floor, groups) -> dict:
+    if classify:
+        classes = sorted(np.unique(np.concatenate([y, pred])))
+        out = _class_scores(y, pred, classes)
+        out["dummy"] = _class_scores(y, floor, classes)
+        out["dummy"].pop("confusion")
+        return out
+    out = {**_reg_scores(y, pred), "mae_se": _case_se(np.abs(pred - y), groups)}
+    out["dummy"] = {**_reg_scores(y, floor), "mae_se": _case_se(np.abs(floor - y), groups)}
+    return out
+
+
+def _test_scores(test, target, inputs, fitted, x, y, classify) -> dict:
+    keep = test.table[target].notna().to_numpy()
+    x_test, y_test = inputs.x(test, keep), test.table[target].to_numpy()[keep]
+    groups = test.table["case"].to_numpy()[keep]
+    floor = models.dummy(classify).fit(x, y).predict(x_test)
+    out = {"dataset": test.name, "n_rows": len(y_test), "n_cases": len(np.unique(groups))}
+    return {**out, **_scores(classify, y_test, fitted.predict(x_test), floor, groups)}
+
+
+def _importances(forest, names) -> dict:
+    order = np.argsort(forest.feature_importances_)[::-1]
+    return {names[i]: float(forest.feature_importances_[i]) for i in order}
+
+
+def _class_scores(y, pred, classes) -> dict:
+    from sklearn import metrics
+
     return {
         "accuracy": float(metrics.accuracy_score(y, pred)),
         "f1_macro": float(metrics.f1_score(y, pred, average="macro")),
@@ -117,60 +197,10 @@ def _case_se(errors, groups) -> float:
     return float(per_case.std(ddof=1) / np.sqrt(len(per_case))) if len(per_case) > 1 else np.nan
 
 
-def _reg_scores(metrics, y, pred) -> dict:
+def _reg_scores(y, pred) -> dict:
+    from sklearn import metrics
+
     return {
         "mae": float(metrics.mean_absolute_error(y, pred)),
-        "r2": float(metrics.r2_score(y, pred)),
+        "r2": float(metrics.r2_score(y, pred)) if len(y) > 1 else np.nan,
     }
-
-
-def confusion_figure(scores: dict, path, title: str = ""):
-    """Confusion matrix (counts and row fractions) of a classification result, as a PNG."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    cm = np.asarray(scores["confusion"], dtype=float)
-    frac = cm / np.maximum(cm.sum(axis=1, keepdims=True), 1)
-    fig, ax = plt.subplots(figsize=(4.2, 3.8), constrained_layout=True)
-    ax.imshow(frac, cmap="Blues", vmin=0, vmax=1)
-    for i in range(cm.shape[0]):
-        for j in range(cm.shape[1]):
-            colour = "white" if frac[i, j] > 0.6 else "black"
-            ax.text(j, i, f"{cm[i, j]:.0f}\n{frac[i, j]:.0%}", ha="center", va="center",
-                    color=colour)  # fmt: skip
-    ticks = range(len(scores["classes"]))
-    ax.set_xticks(ticks, scores["classes"])
-    ax.set_yticks(ticks, scores["classes"])
-    ax.set_xlabel("predicted")
-    ax.set_ylabel("true")
-    ax.set_title(
-        title
-        or f"accuracy {scores['accuracy']:.1%}, F1 {scores['f1_macro']:.2f}\n"
-        f"({scores['n_rows']} windows, {scores['n_cases']} cases, grouped {scores['folds']}-fold)",
-        fontsize=9,
-    )
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
-
-
-def importance_figure(scores: dict, path, top: int = 15):
-    """Bar chart of the ``top`` feature importances, as a PNG."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    items = list(scores["importances"].items())[:top][::-1]
-    fig, ax = plt.subplots(figsize=(5.5, 0.25 * len(items) + 1.2), constrained_layout=True)
-    ax.barh([k for k, _ in items], [v for _, v in items], color="tab:blue")
-    ax.set_xlabel("importance (mean impurity decrease; all features sum to 1)")
-    ax.set_title(
-        f"random forest, target {scores['target']} (band_, wp_: energy fractions)", fontsize=9
-    )
-    ax.tick_params(axis="y", labelsize=8)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path

@@ -9,7 +9,8 @@ Two kinds of window, each a row of the table with one column per sensor and feat
 - ``fixed``: consecutive non-overlapping windows of ``length`` s; the row's ``label`` is the
   case's label (coal | gangue | mixed) and ``gangue_fraction`` the case's.
 Every row also carries ``case`` (for grouped cross-validation), ``window``, ``t_start`` (s),
-the case's labels and swept values.
+the case's labels and swept values. ``window_table`` gives the same rows with the raw windows
+instead of their features (for models that read the signal itself, e.g. MiniRocket).
 """
 
 import numpy as np
@@ -100,14 +101,12 @@ def _fixed_block(acc, ids, fs, length):
     return win, meta
 
 
-def feature_table(
+def window_blocks(
     path, *, window="impact", length=0.02, pre=0.0005, noise_rms=0.0, first_only=False
 ):
-    """The feature table of the dataset at ``path`` (see module docstring); a DataFrame.
-
-    ``noise_rms`` (m/s^2): white noise added to the stored signals first (add_noise), to
-    study separability against SNR without simulating again. ``first_only``: impact windows
-    of each ball's first impact only."""
+    """The windows of the dataset at ``path`` (see module docstring), a block of cases at a
+    time: yields (windows (rows, sensor, samples) in m/s^2, meta DataFrame of the rows) after
+    a first item (sensors, sample rate Hz, case table). Arguments as feature_table's."""
     import pandas as pd
 
     if window not in ("impact", "fixed"):
@@ -123,11 +122,11 @@ def feature_table(
         impacts = impacts[impacts["partner"].fillna("plate") == "plate"]
     if impacts is not None and first_only:
         impacts = impacts[impacts["index"] == 1]
-    cases = case_table(ds)
     sensors = [str(s) for s in ds["sensor"].values]
-    frames, dropped = [], 0
+    yield sensors, fs, case_table(ds)
+    dropped = 0
     ids_all = ds["case"].values
-    with task(f"features of {len(ids_all)} cases", total=len(ids_all), unit="cases") as bar:
+    with task(f"windows of {len(ids_all)} cases", total=len(ids_all), unit="cases") as bar:
         for lo in range(0, len(ids_all), BLOCK_CASES):
             ids = ids_all[lo : lo + BLOCK_CASES]
             block = ds.isel(case=slice(lo, lo + len(ids)))
@@ -140,17 +139,66 @@ def feature_table(
             else:
                 win, meta = _fixed_block(acc, ids, fs, n)
             if len(meta):
-                frames.append(_features_frame(win, fs, sensors, meta))
+                yield win, meta
             bar.update(len(ids))
     if dropped:
         note(
             f"features: {dropped} impacts left out, their {length:g} s window runs past the record"
         )
-    if not frames:
-        raise InputError("DATASET", "no windows: the dataset has no impacts that fit a window")
-    table = pd.concat(frames, ignore_index=True)
+
+
+def _with_cases(table, cases, window: str):
     if window == "impact":
         cases = cases.rename(columns={"label": "case_label"})
     return table.join(
         cases.drop(columns=[c for c in cases.columns if c in table.columns]), on="case"
     )
+
+
+def _no_windows():
+    return InputError("DATASET", "no windows: the dataset has no impacts that fit a window")
+
+
+def feature_table(
+    path, *, window="impact", length=0.02, pre=0.0005, noise_rms=0.0, first_only=False
+):
+    """The feature table of the dataset at ``path`` (see module docstring); a DataFrame.
+
+    ``noise_rms`` (m/s^2): white noise added to the stored signals first (add_noise), to
+    study separability against SNR without simulating again. ``first_only``: impact windows
+    of each ball's first impact only. The window settings are kept in ``table.attrs["windows"]``
+    (written to features.parquet), so the raw windows can be cut again (window_table)."""
+    import pandas as pd
+
+    settings = dict(
+        window=window, length=length, pre=pre, noise_rms=noise_rms, first_only=first_only
+    )
+    blocks = window_blocks(path, **settings)
+    sensors, fs, cases = next(blocks)
+    frames = [_features_frame(win, fs, sensors, meta) for win, meta in blocks]
+    if not frames:
+        raise _no_windows()
+    table = _with_cases(pd.concat(frames, ignore_index=True), cases, window)
+    table.attrs["windows"] = settings
+    return table
+
+
+def window_table(path, **settings):
+    """(meta table, windows (rows, sensor, samples) in m/s^2, sensors, sample rate Hz): the
+    raw windows feature_table computes its features of, with the same rows in the same order
+    (``settings``: feature_table's keyword arguments, e.g. ``table.attrs["windows"]``)."""
+    import pandas as pd
+
+    blocks = window_blocks(path, **settings)
+    sensors, fs, cases = next(blocks)
+    wins, metas = [], []
+    for win, meta in blocks:
+        wins.append(win)
+        metas.append(meta)
+    if not metas:
+        raise _no_windows()
+    table = _with_cases(
+        pd.concat(metas, ignore_index=True), cases, settings.get("window", "impact")
+    )
+    table.attrs["windows"] = dict(settings)
+    return table, np.concatenate(wins), sensors, fs
