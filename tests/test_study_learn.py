@@ -90,6 +90,22 @@ def test_cross_validation_is_grouped_by_case():
     assert scores["accuracy"] < 0.75  # near 0.5; ungrouped folds would give ~1.0
 
 
+def test_cross_validation_groups_by_the_column_asked():
+    # 40 cases, each cut from one of 8 recordings whose label and features it shares: folds
+    # grouped by case see every recording in training and score ~1; grouped by recording,
+    # only chance is left
+    rng = np.random.default_rng(1)
+    source = np.repeat(np.arange(8), 5)
+    x = rng.standard_normal((8, 3))[source] + 1e-3 * rng.standard_normal((40, 3))
+    table = pd.DataFrame(x, columns=["S1.rms", "S1.peak", "S1.kurtosis"])
+    table["case"] = np.arange(40)
+    table["source_file"] = [f"r{k}.wav" for k in source]
+    table["label"] = np.array(["coal", "gangue"] * 4)[source]
+    assert learn(table, "label", folds=4)["accuracy"] > 0.9
+    scores = learn(table, "label", folds=4, groups="source_file")
+    assert scores["accuracy"] < 0.75 and scores["groups"] == "source_file"
+
+
 def test_undefined_features_are_imputed_not_dropped():
     rng = np.random.default_rng(1)
     table = pd.DataFrame(rng.standard_normal((30, 2)), columns=["S1.rms", "S1.decay_rate"])

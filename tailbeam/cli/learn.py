@@ -31,13 +31,23 @@ def add_arguments(parser):
         help="comma-separated sensor names to use (default: every sensor)",
     )
     parser.add_argument(
+        "--groups",
+        default="case",
+        metavar="COLUMN",
+        help="a column whose values never sit on both sides of a fold (source_file: cases cut "
+        "from one recording)",
+    )
+    parser.add_argument(
         "--model",
         default="forest",
         choices=("forest", "minirocket"),
         help="a random forest on the features, or MiniRocket and ridge on the raw windows",
     )
     parser.add_argument(
-        "--test", default=None, metavar="OTHER", help="another dataset to score the model on"
+        "--test",
+        default=None,
+        metavar="OTHER",
+        help="another dataset to score the model on (default: none)",
     )
     parser.add_argument(
         "--normalise", action="store_true", help="blind to gain: scale-free input only"
@@ -73,7 +83,7 @@ def run(args) -> int:
     test = _samples(args.test, args.model, settings, args.test)[0] if args.test else None
     scores = learn(
         train, args.target, folds=args.folds, sensors=sensors, model=args.model,
-        normalise=args.normalise, test=test,
+        normalise=args.normalise, test=test, groups=args.groups,
     )  # fmt: skip
     scores["windows"] = settings
     out = Path(args.out) if args.out else folder / "learn"

@@ -34,11 +34,12 @@ class Samples:
 
 def learn(
     data, target="label", *, folds=5, seed=0, sensors=None, model="forest", normalise=False,
-    test=None,
+    test=None, groups="case",
 ) -> dict:  # fmt: skip
     """Cross-validated scores of ``model`` and the dummy on ``data`` (Samples, or a feature
     table for the forest), and with ``test`` (Samples, or a list of them) the scores on it of
-    both fitted on all of ``data``.
+    both fitted on all of ``data``. ``groups`` names the column whose values never sit on both
+    sides of a fold: ``case`` by default; ``source_file`` for cases cut from one recording.
 
     Returns a dict: model, normalise, target, n_rows, n_cases, folds, sensors, features, and
     for a label "accuracy", "f1_macro", "classes", "confusion" (rows true, columns
@@ -59,16 +60,19 @@ def learn(
         inputs.check(other)
     keep = data.table[target].notna().to_numpy()
     x, y = inputs.x(data, keep), data.table[target].to_numpy()[keep]
-    groups = data.table["case"].to_numpy()[keep]
-    n_cases = len(np.unique(groups))
-    if n_cases < folds:
-        raise InputError("--folds", f"needs at least {folds} cases, the dataset has {n_cases}")
+    if groups not in data.table.columns:
+        raise InputError("--groups", f"the feature table has no column {groups!r}")
+    group_of = data.table[groups].to_numpy()[keep]
+    n_groups = len(np.unique(group_of))
+    if n_groups < folds:
+        raise InputError("--folds", f"needs at least {folds} {groups} values, found {n_groups}")
+    n_cases = len(np.unique(data.table["case"].to_numpy()[keep]))
     classify = target == "label"
     if classify and len(np.unique(y)) < 2:
         raise InputError("--target", f"needs two classes or more, found only {np.unique(y)}")
     cv = GroupKFold(n_splits=folds)
-    pred = cross_val_predict(models.make(model, classify, seed), x, y, groups=groups, cv=cv)
-    floor = cross_val_predict(models.dummy(classify), x, y, groups=groups, cv=cv)
+    pred = cross_val_predict(models.make(model, classify, seed), x, y, groups=group_of, cv=cv)
+    floor = cross_val_predict(models.dummy(classify), x, y, groups=group_of, cv=cv)
     out = {
         "model": model,
         "normalise": bool(normalise),
@@ -76,9 +80,10 @@ def learn(
         "n_rows": len(y),
         "n_cases": n_cases,
         "folds": folds,
+        "groups": groups,
         "sensors": inputs.sensors,
         "features": inputs.names,
-        **_scores(classify, y, pred, floor, groups),
+        **_scores(classify, y, pred, floor, data.table["case"].to_numpy()[keep]),
         "importances": {},
     }
     if model == "forest" or tests:
