@@ -19,6 +19,12 @@ def add_arguments(parser):
     where.add_argument(
         "--scheduler", default=None, help="address of a running Dask scheduler (tcp://host:port)"
     )
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="refuse the sweep, before any case runs, if a case's band check estimates a "
+        "peak-force error above the sweep file's band_accuracy",
+    )
 
 
 def run(args) -> int:
@@ -32,10 +38,30 @@ def run(args) -> int:
 
     spec = load_sweep(args.sweep)
     cases = expand(spec)  # every case's scene validated before a worker starts
+    if args.strict:
+        _refuse_invalid(cases, spec.band_accuracy)
     s = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, cases=cases)
     ran = s["ok"] + s["failed"]
     print(
         f"{args.sweep}: {s['cases']} cases, {s['skipped']} already done, {ran} run "
-        f"({s['ok']} ok, {s['failed']} failed); dataset in {args.out}"
+        f"({s['ok']} ok, {s['failed']} failed, {s.get('invalid', 0)} flagged invalid); dataset "
+        f"in {args.out}"
     )
     return 1 if s["failed"] else 0
+
+
+def _refuse_invalid(cases, accuracy: float) -> None:
+    """--strict: InputError naming the first case whose band check exceeds ``accuracy``."""
+    from tailbeam.study.sweep import invalid_up_front
+
+    bad = invalid_up_front(cases, accuracy)
+    if bad:
+        number, case, columns = bad[0]
+        shown = ", ".join(f"{k} = {v!r}" for k, v in case.params.items())
+        raise InputError(
+            "--strict",
+            f"{len(bad)} of {len(cases)} cases exceed band_accuracy {accuracy:g}, first case "
+            f"{number} ({shown}): band_force_error {columns['band_force_error']:.3g} at "
+            f"{columns['band_hz'] / 1e3:g} kHz; raise plate.fmax in the base scene, narrow the "
+            "axes, or raise band_accuracy in the sweep file",
+        )
