@@ -31,6 +31,12 @@ def add_arguments(parser):
         help="address of a running Dask scheduler, tcp://host:port (default: a local cluster)",
     )
     export.add_export_option(parser, "every finished case (DIR/uff/)")
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="refuse the sweep, before any case runs, if a case's band check estimates a "
+        "peak-force error above the sweep file's band_accuracy",
+    )
 
 
 def run(args) -> int:
@@ -48,11 +54,14 @@ def run(args) -> int:
         from tailbeam.io.output import check_output_dir
 
         check_output_dir(Path(args.out) / "uff", field="--export")
+    if args.strict:
+        _refuse_invalid(cases, spec.band_accuracy)
     s = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, cases=cases)
     ran = s["ok"] + s["failed"]
     print(
         f"{args.sweep}: {s['cases']} cases, {s['skipped']} already done, {ran} run "
-        f"({s['ok']} ok, {s['failed']} failed); dataset in {args.out}"
+        f"({s['ok']} ok, {s['failed']} failed, {s.get('invalid', 0)} flagged invalid); dataset "
+        f"in {args.out}"
     )
     for fmt in export.chosen(args):
         _export(args, fmt)
@@ -69,3 +78,20 @@ def _export(args, fmt: str) -> None:
     out = Path(args.out) / "uff"
     e = export_dataset(args.out, out, fmt, command=f"tailbeam sweep {args.sweep} --export {fmt}")
     print(f"{args.sweep}: {e['cases']} finished cases written as UFF 58 files to {out}")
+
+
+def _refuse_invalid(cases, accuracy: float) -> None:
+    """--strict: InputError naming the first case whose band check exceeds ``accuracy``."""
+    from tailbeam.study.sweep import invalid_up_front
+
+    bad = invalid_up_front(cases, accuracy)
+    if bad:
+        number, case, columns = bad[0]
+        shown = ", ".join(f"{k} = {v!r}" for k, v in case.params.items())
+        raise InputError(
+            "--strict",
+            f"{len(bad)} of {len(cases)} cases exceed band_accuracy {accuracy:g}, first case "
+            f"{number} ({shown}): band_force_error {columns['band_force_error']:.3g} at "
+            f"{columns['band_hz'] / 1e3:g} kHz; raise plate.fmax in the base scene, narrow the "
+            "axes, or raise band_accuracy in the sweep file",
+        )

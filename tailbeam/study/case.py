@@ -112,6 +112,40 @@ def _counts(rows: list, stream: bool) -> dict:
     return out
 
 
+def band_estimate(scene) -> dict:
+    """{"band_hz", "band_force_error"} the case's run will record (``_band_columns``), from its
+    band check alone, before any basis is computed (single ball: ``choose_band``, ~10 ms a
+    ball; stream: ``check_stream_band`` over its particles); {} on the rigid plate."""
+    from tailbeam.solvers.modal_setup.band import check_stream_band, choose_band, stream_band
+
+    if scene.plate_model != "modal":
+        return {}
+    if scene.needs_stream_solver:
+        band = stream_band(scene)
+        check_stream_band(scene, band)
+    else:
+        band = choose_band(scene, scene.modal)
+    error = band.get("truncation_force_error", math.nan)
+    return {"band_hz": float(band["fmax_hz"]), "band_force_error": float(error)}
+
+
+def validity(columns: dict, accuracy: float) -> dict:
+    """{"valid": bool, "invalid_reason": text}: a case is invalid when its band check's
+    estimate ``band_force_error`` (from ``columns``) exceeds ``accuracy`` (the sweep's
+    band_accuracy); NaN (rigid plate, no estimate) is valid."""
+    error = columns.get("band_force_error", math.nan)
+    if not error > accuracy:
+        return {"valid": True, "invalid_reason": ""}
+    band = columns.get("band_hz", math.nan)
+    return {
+        "valid": False,
+        "invalid_reason": (
+            f"band_force_error {error:.3g} > band_accuracy {accuracy:g}: the modal band "
+            f"0-{band / 1e3:g} kHz is too low for the case's shortest contact (raise plate.fmax)"
+        ),
+    }
+
+
 def run_case(scene_toml: str, *_after) -> dict:
     """Simulate one case. Returns {"status": "ok" | "failed", "error", "wall_time",
     "cpu_time" (s, this process),

@@ -5,7 +5,8 @@
   case hash, seed, repeat, labels (``label``, ``gangue_fraction``, ``n_coal``, ``n_gangue``,
   ``n_coal_impacts``, ``n_gangue_impacts``; for stream scenes also ``gangue_mass_fraction``,
   ``n_particles``, ``n_ball_contacts``), the modal band ``band_hz`` and the band check's
-  estimate of the peak-force error ``band_force_error`` (NaN on the rigid plate), and every
+  estimate of the peak-force error ``band_force_error`` (NaN on the rigid plate), ``valid``
+  (that estimate within the sweep's ``band_accuracy``) and ``invalid_reason``, and every
   swept value (vector values one coordinate per component, ``key[i]``); ``sensor_x``,
   ``sensor_y`` (case, sensor) in m.
   Attributes: units, sample rate (Hz), duration (s), the base sensor positions, the tailbeam
@@ -15,7 +16,7 @@
   every impacts.csv column, ``class`` = the ball's ``label``).
 - ``cases.csv``: one row per case run so far: ``case``, ``case_hash``, ``status`` (ok | failed),
   ``error`` (one line), ``wall_time`` and ``cpu_time`` (s, on the worker), seed, repeat,
-  labels and the swept values.
+  labels, band, ``valid``, ``invalid_reason`` and the swept values (docs/datasets.md).
 
 Order of writes per batch: impacts.parquet (whole table, atomic rename), then the Zarr append,
 then cases.csv. The Zarr store is the record of finished cases: on opening, impact rows of
@@ -32,6 +33,8 @@ import numpy as np
 
 from tailbeam._version import __version__
 from tailbeam.io.scene_file import loads_scene
+from tailbeam.solvers.modal_setup.band import BAND_ACCURACY
+from tailbeam.study.case import validity
 
 LABEL_COLUMNS = (
     "label",
@@ -46,6 +49,8 @@ STREAM_LABEL_COLUMNS = ("gangue_mass_fraction", "n_particles")
 STREAM_RESULT_COLUMNS = ("n_ball_contacts",)
 # the modal band of a case and the band check's estimate of its peak-force error (NaN: rigid)
 BAND_COLUMNS = ("band_hz", "band_force_error")
+# whether that estimate is within the sweep's band_accuracy (tailbeam.study.case.validity)
+VALIDITY_COLUMNS = ("valid", "invalid_reason")
 LEDGER_COLUMNS = (
     "case",
     "case_hash",
@@ -85,9 +90,10 @@ def _atomic_write(path: Path, write) -> None:
 class DatasetStore:
     """The dataset files of one output folder: what is done, and appending finished cases."""
 
-    def __init__(self, out_dir, sweep_text: str = ""):
+    def __init__(self, out_dir, sweep_text: str = "", band_accuracy: float = BAND_ACCURACY):
         import pandas as pd
 
+        self.band_accuracy = band_accuracy
         self.dir = Path(out_dir)  # created by the first record()
         self.zarr_path = self.dir / "dataset.zarr"
         self.sweep_text = sweep_text
@@ -174,6 +180,7 @@ class DatasetStore:
                 "n_gangue_impacts": result["n_gangue_impacts"],
                 **{k: result[k] for k in STREAM_RESULT_COLUMNS if k in result},
                 **{k: result.get(k, float("nan")) for k in BAND_COLUMNS},
+                **self._validity(result),
                 **flat_params(case.params),
             }
             rows.append(row)
@@ -184,6 +191,12 @@ class DatasetStore:
             self._append_zarr(ok)
         self._set_rows(rows)
         _atomic_write(self.dir / "cases.csv", lambda p: self.ledger.to_csv(p, index=False))
+
+    def _validity(self, result: dict) -> dict:
+        """``valid`` and ``invalid_reason`` of a case's result (a failed case: not valid)."""
+        if result["status"] != "ok":
+            return {"valid": False, "invalid_reason": "failed (see error)"}
+        return validity(result, self.band_accuracy)
 
     def _write_impacts(self, ok: list) -> None:
         import pandas as pd

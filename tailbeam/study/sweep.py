@@ -23,7 +23,7 @@ import uuid
 from tailbeam.errors import InputError
 from tailbeam.io.scene_file import loads_scene
 from tailbeam.progress import note, task
-from tailbeam.study.case import run_case, warm_basis
+from tailbeam.study.case import band_estimate, run_case, validity, warm_basis
 from tailbeam.study.dataset import DatasetStore
 from tailbeam.study.design import expand
 
@@ -150,7 +150,7 @@ def plan(spec, out_dir, cases=None):
     """(all cases, cases still to run, store): the finished cases of out_dir are skipped.
     ``cases``: expand(spec) if already computed."""
     cases = expand(spec) if cases is None else cases
-    store = DatasetStore(out_dir, spec.text)
+    store = DatasetStore(out_dir, spec.text, spec.band_accuracy)
     done = store.done()
     todo, seen = [], set(done)
     for c in cases:
@@ -190,6 +190,26 @@ def _band_note(toml: str) -> None:
         warning = check_stream_band(scene, stream_band(scene))
         if warning:
             note(f"{warning} [first case of its basis]")
+
+
+def _invalid_note(case, result, accuracy: float, count: int) -> None:
+    """One line on stderr for a case flagged invalid (``valid`` False in cases.csv)."""
+    shown = ", ".join(f"{k} = {v!r}" for k, v in case.params.items())
+    reason = validity(result, accuracy)["invalid_reason"]
+    note(f"case {case.hash[:12]} ({shown}) flagged invalid ({count} so far): {reason}")
+
+
+def invalid_up_front(cases, accuracy: float) -> list:
+    """(number from 1, case, band columns) of the cases whose band check, run before any
+    basis (``case.band_estimate``), exceeds ``accuracy``."""
+    out = []
+    with task(f"band check of {len(cases)} cases", total=len(cases), unit="cases") as bar:
+        for number, case in enumerate(cases, start=1):
+            columns = band_estimate(loads_scene(case.toml))
+            if not validity(columns, accuracy)["valid"]:
+                out.append((number, case, columns))
+            bar.update(1)
+    return out
 
 
 def _pause(futures: dict, rate: float) -> None:
@@ -238,7 +258,8 @@ def run_sweep(spec, out_dir, *, workers=None, scheduler=None, client=None, cases
     from dask.distributed import as_completed
 
     cases, todo, store = plan(spec, out_dir, cases)
-    summary = {"cases": len(cases), "skipped": len(cases) - len(todo), "ok": 0, "failed": 0}
+    summary = {"cases": len(cases), "skipped": len(cases) - len(todo), "ok": 0, "failed": 0,
+               "invalid": 0}  # fmt: skip
     if not todo:
         note(f"sweep: all {len(cases)} cases already done in {out_dir}")
         return summary
@@ -265,6 +286,9 @@ def run_sweep(spec, out_dir, *, workers=None, scheduler=None, client=None, cases
                         bar.set_postfix(f"{summary['failed']} failed")
                         note(f"case {case.hash[:12]} failed ({summary['failed']} so far): "
                              f"{result['error']}")  # fmt: skip
+                    elif not validity(result, spec.band_accuracy)["valid"]:
+                        summary["invalid"] += 1
+                        _invalid_note(case, result, spec.band_accuracy, summary["invalid"])
                     batch.add(case, result)
                 bar.update(len(done))
                 if batch.full():

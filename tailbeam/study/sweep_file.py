@@ -5,6 +5,8 @@ A sweep file names a base scene and the axes that vary::
     scene = "base.toml"          # a scene file (relative to the sweep file), or an inline [scene]
     repeats = 2                  # independent seeds per design point (default 1)
     seed = 7                     # seed of the random design and of the case seeds (default 0)
+    band_accuracy = 0.005        # a case whose band check estimates a larger peak-force error
+                                 # is flagged invalid (default: the band check's own 0.5 %)
 
     [labels]
     coal = ["coal"]              # materials counted as coal; every other material is gangue
@@ -33,6 +35,7 @@ from pathlib import Path
 
 from tailbeam.errors import InputError, require_positive
 from tailbeam.io.scene_file import _check_keys
+from tailbeam.solvers.modal_setup.band import BAND_ACCURACY
 from tailbeam.study.scene_keys import _field, _segments, set_value
 
 if sys.version_info >= (3, 11):
@@ -40,7 +43,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-SWEEP_KEYS = ("scene", "repeats", "seed", "labels", "axes")
+SWEEP_KEYS = ("scene", "repeats", "seed", "labels", "axes", "band_accuracy")
 DISTRIBUTIONS = {
     "uniform": ("low", "high"),
     "loguniform": ("low", "high"),
@@ -64,7 +67,8 @@ class Axis:
 
 @dataclass(frozen=True)
 class SweepSpec:
-    """A validated sweep file: the base scene table, axes, repeats, seed, coal materials."""
+    """A validated sweep file: the base scene table, axes, repeats, seed, coal materials and
+    the largest band-check estimate of a case's peak-force error it accepts as valid."""
 
     base: dict
     axes: tuple
@@ -72,6 +76,7 @@ class SweepSpec:
     seed: int = 0
     coal: tuple = ("coal",)
     text: str = ""
+    band_accuracy: float = BAND_ACCURACY
 
 
 def _whole(field: str, value, low: int) -> int:
@@ -110,7 +115,15 @@ def parse_sweep(data: dict, *, base_dir=".", text: str = "") -> SweepSpec:
         seed=_whole("seed", data.get("seed", 0), 0),
         coal=tuple(coal),
         text=text,
+        band_accuracy=_accuracy(data.get("band_accuracy", BAND_ACCURACY)),
     )
+
+
+def _accuracy(value) -> float:
+    ok = isinstance(value, int | float) and not isinstance(value, bool)
+    if not ok or not math.isfinite(value) or value <= 0.0:
+        raise InputError("band_accuracy", f"must be a number > 0 (0.005: 0.5 %), got {value!r}")
+    return float(value)
 
 
 def _base_scene(value, base_dir: Path) -> dict:

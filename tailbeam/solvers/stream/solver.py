@@ -27,6 +27,7 @@ from tailbeam.solvers.stream.driver.loop import (
 from tailbeam.solvers.stream.numbering import number_contacts
 from tailbeam.solvers.stream.plate import StreamPlate
 from tailbeam.solvers.stream.reference.solver import simulate_stream_reference
+from tailbeam.streams.delivery import delivery, delivery_line
 
 MAX_STREAM_MEMORY = 2e9  # bytes a stream run may be estimated to keep (the work bound's)
 REFERENCE_MAX_PARTICLES = 20  # the reference watches every pair: O(N^2) per step
@@ -74,7 +75,7 @@ class Stream(Solver):
             return simulate_stream(
                 scene.particles, scene.incline, scene.duration, laws=scene.contacts(),
                 rtol=rtol, max_steps=max_steps, progress=advance, setup=plate,
-                sensors=scene.sensors, info={"solver_choice": self.name},
+                sensors=scene.sensors, info={"solver_choice": self.name}, streams=scene.streams,
             )  # fmt: skip
 
     def _announce(self, scene, rtol, max_steps):
@@ -130,7 +131,7 @@ class StreamReference(Stream):
 def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
                     rtol: float = DEFAULT_RTOL, max_steps: int = DEFAULT_MAX_STEPS,
                     progress=True, rest_speed: float = DEFAULT_REST_SPEED, setup=None,
-                    sensors=(), info=None) -> Result:  # fmt: skip
+                    sensors=(), info=None, streams=()) -> Result:  # fmt: skip
     """The fast stream solver on ``particles`` (``tailbeam.streams.generator.Particle``).
 
     Parameters
@@ -151,6 +152,10 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         The sensors the result's plate response is read at.
     info : dict, optional
         More entries for ``Result.info``.
+    streams : sequence of StreamSettings
+        The streams ``particles`` come from: what each delivered goes to ``info["streams"]``
+        (``tailbeam.streams.delivery``) and is said on stderr; the largest release delay (s)
+        of any particle to ``stats["release_delay_max"]``.
     """
     run = solve_stream(
         particles, incline, duration, rtol=rtol, rest_speed=rest_speed, max_work=max_steps,
@@ -158,14 +163,28 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         contacts=contact_table(particles, laws, incline.plate.material),
     )  # fmt: skip
     number_contacts(run.contacts, run.leaves, incline)
+    flow = _delivered(streams, particles, run, duration)
     return Result(
         duration=duration, particles=tuple(run.particles),
         impacts=sorted(run.contacts, key=lambda r: (r.t_start, r.ball)), events=run.events,
         leaves=run.leaves, status=run.status, message=run.message, stats=run.stats,
         info={"solver": "fast stream solver (event-driven, active-set DOP853)",
-              **(setup.info() if setup else {}), **(info or {})},
+              **(setup.info() if setup else {}), **flow, **(info or {})},
         sensors=tuple(sensors), plate=_response(setup, run),
     )  # fmt: skip
+
+
+def _delivered(streams, particles, run, duration) -> dict:
+    """``{"streams": delivery}`` of the run's streams (said on stderr; empty without streams);
+    sets ``run.stats["release_delay_max"]`` (s)."""
+    delays = [r.t_release - p.t_release for p, r in zip(particles, run.particles, strict=True)]
+    run.stats["release_delay_max"] = max(delays, default=0.0)
+    if not streams:
+        return {}
+    flow = delivery(streams, particles, run.particles, duration)
+    for name, entry in flow.items():
+        note(delivery_line(name, entry))
+    return {"streams": flow}
 
 
 def simulate_reference(
