@@ -7,7 +7,8 @@ by one or more names (``raise max_contacts, or rest_speed``); a name is a settin
 starts with ``--``, holds ``_`` or ``.``, is written ``name=`` somewhere in the message, or
 is a documented name. Each setting must be documented where a user can set it:
 
-- a scene key: a row `` `plate.tail` `` of docs/scene-files.md (``balls[2].radius`` is the
+- a scene key: a row `` `plate.tail` `` of docs/scene-files.md, or a sweep-file key of
+  docs/datasets.md (``balls[2].radius`` is the
   row ``balls.radius``; a bare ``residual_flexibility`` is the last part of one row);
 - a command-line option: a row `` `tailbeam simulate --out` `` of docs/cli.md;
 - a keyword of the library call ``tailbeam.simulate(scene, *, ...)`` as README.md gives it;
@@ -98,6 +99,7 @@ def messages(path: Path):
 def documented() -> frozenset:
     """Every name a user can set (module docstring), normalised (no indices, no '=')."""
     scene = ROW.findall((ROOT / "docs" / "scene-files.md").read_text())
+    scene += ROW.findall((ROOT / "docs" / "datasets.md").read_text())  # sweep-file keys
     names = set(scene) | {key.rsplit(".", 1)[-1] for key in scene}
     for row in ROW.findall((ROOT / "docs" / "cli.md").read_text()):
         names.update(w for w in row.split() if w.startswith("--"))
