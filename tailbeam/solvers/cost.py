@@ -22,9 +22,13 @@ drives it and whether it is already cached:
   anti-alias filter (O(taps));
 - ``writing``: the CSV files (per value) and one figure per sensor (per sample).
 
-The constants were fitted on this project's 2-core machine (shared, load 5-11) with
-``benchmarks/bench_cost_model.py``; its table is in docs/band-and-cost.md. They estimate, they
-do not bound: measured / estimated came out within 0.5-2 over that spread.
+- ``set-up`` (single balls): the band's contact pulses and, where ``plate.tail`` builds it,
+  the Ritz tail's pre-pass (FE solves: DOF^1.5 per contact point).
+
+The constants were fitted on this project's 2-core machine, shared with other jobs, one
+BLAS thread, with ``benchmarks/bench_cost_model.py`` (its table is in docs/band-and-cost.md),
+between runs at load averages ~6 and ~10, where the same scenes took 2-3x longer. They
+estimate, they do not bound.
 """
 
 import math
@@ -32,41 +36,43 @@ from dataclasses import dataclass
 
 from tailbeam.errors import InputError
 
-EIGEN_TIME = 1.0e-8  # s / (DOF mode^2) of a Lanczos band solve, one BLAS thread
-EIGEN_BASE = 1.0  # s: assembling the FE model and factorising, per solve
+EIGEN_TIME = 1.5e-8  # s / (DOF mode^2) of a Lanczos band solve, one BLAS thread
+EIGEN_BASE = 0.6  # s: assembling the FE model and factorising, per solve
 EIGEN_WORDS = 6.0  # doubles per DOF per mode held during the solve (and by a loaded basis)
 BASE_MEMORY = 2.0e8  # bytes: interpreter, numpy, scipy, numba
 MODAL_BASE_MEMORY = 3.0e8  # bytes: the same with the FE assembly and the modal kernels
-CACHE_LOAD_BYTES_PER_S = 2e8  # reading a cached basis (npz)
-SETUP_BASE = 0.5  # s: the band's contact pulses, building the basis' probes
-RITZ_DOF_POINT = 2e-4  # s per DOF and contact point: the Ritz tail's pre-pass (single balls)
-COUPLED_BASE = 0.5  # s: a coupled run's set-up and result
-COUPLED_BALL = 0.12  # s per ball: its residual compliance (an FE load solve), its records
-COUPLED_STEP = 4e-9  # s per step, mode and ball^2 (single balls on the modal plate)
-COUPLED_STEP_BASE = 3e-6  # s per step
+CACHE_LOAD_BYTES_PER_S = 5e8  # reading a cached basis (npz)
+SETUP_BASE = 0.02  # s: the band's contact pulses, building the basis' probes
+RITZ_DOF_POINT = 5.5e-7  # s per DOF^1.5 and contact point: the Ritz tail's pre-pass (FE solves)
+COUPLED_BASE = 0.03  # s: a coupled run's set-up and result
+COUPLED_BALL = 0.066  # s per ball: its residual compliance (an FE load solve), its records
+COUPLED_STEP = 2.2e-9  # s per step, mode and ball^2 (single balls on the modal plate)
+COUPLED_STEP_BASE = 1.6e-6  # s per step
 COUPLED_OVERHEAD = 1.3  # steps per contact step: event location, flights
-RIGID_BASE = 0.05  # s
-RIGID_IMPACT = 2e-3  # s per impact (rigid plate, one DOP853 contact integration)
-STREAM_BASE = 1.5  # s: the stream solver's set-up (contact table, driver, kernels)
-STREAM_PARTICLE = 8e-3  # s per particle, fast stream solver, rigid plate
-STREAM_PARTICLE_MODE = 6e-2  # s per particle and 100 modes in the active sets (two-way)
+RIGID_BASE = 0.01  # s
+RIGID_IMPACT = 2.8e-4  # s per impact (rigid plate, one DOP853 contact integration)
+STREAM_BASE = 0.8  # s: the stream solver's set-up (contact table, driver, kernels)
+STREAM_PARTICLE = 4.4e-3  # s per particle, fast stream solver, rigid plate
+STREAM_PARTICLE_MODE = 3.5e-2  # s per particle and 100 modes in the active sets (two-way)
 STREAM_PARTICLE_TAIL = 8e-4  # s per particle and tail oscillator (two-way, contact tails)
-REFERENCE_STEP = 6e-3  # s per step of the stream reference at REFERENCE_PARTICLES
+REFERENCE_STEP = 4.5e-3  # s per step of the stream reference at REFERENCE_PARTICLES
 REFERENCE_PARTICLES = 12
 REFERENCE_STEPS_PER_CONTACT = 20
 REFERENCE_STEPS_PER_PARTICLE = 20
-REPLAY_BASE = 1.5  # s: importing scipy.signal, once
-REPLAY_SENSOR = 1.0  # s per sensor: its chain's filters, the quasi-static correction
-REPLAY_SAMPLE_MODE = 1.5e-8  # s per fine sample and mode (modal response at the sensor)
-REPLAY_SAMPLE = 3.0e-7  # s per fine sample: resonance FFT, anti-alias filter, spectrum
-REPLAY_PARTICLE_MODE = 5e-4  # s per stream particle and mode: its loads' modal response
+REPLAY_BASE = 0.35  # s: importing scipy.signal, once
+REPLAY_SENSOR = 0.25  # s per sensor: its chain's filters
+REPLAY_SENSOR_MODE = 3e-3  # s per sensor and mode: the quasi-static correction there
+REPLAY_RITZ = 6e-7  # s per sensor and DOF^1.5: the Ritz tail's static part (FE solves)
+REPLAY_SAMPLE_MODE = 1.0e-8  # s per fine sample and mode (modal response at the sensor)
+REPLAY_SAMPLE = 2.0e-7  # s per fine sample: resonance FFT, anti-alias filter, spectrum
+REPLAY_PARTICLE_MODE = 1.5e-4  # s per stream particle and mode: its loads' modal response
 REPLAY_WORDS = 12.0  # doubles held per fine sample (signal, padded FFT, filtered copies)
-WRITE_BASE = 0.1  # s: impacts.csv, particles.csv, impacts.json
-WRITE_VALUE = 8e-6  # s per CSV value written (numbers formatted by Python)
-PLOT_BASE = 2.5  # s: importing matplotlib, once, when a sensor is plotted
-FIGURE_BASE = 2.5  # s per figure
+WRITE_BASE = 0.03  # s: impacts.csv, particles.csv, impacts.json
+WRITE_VALUE = 1.8e-6  # s per CSV value written (numbers formatted by Python)
+PLOT_BASE = 1.2  # s: importing matplotlib, once, when a sensor is plotted
+FIGURE_BASE = 1.2  # s per figure
 FIGURE_SAMPLE = 2e-6  # s per sample plotted (a sensor's figure: signal and spectrum)
-SENSOR_TIME_LIMIT = 120.0  # s: refuse a sensor whose replay and outputs would take longer
+SENSOR_TIME_LIMIT = 30.0  # s: refuse a sensor whose replay and outputs would take longer
 SENSOR_MEMORY_LIMIT = 3.0e9  # bytes: or hold more
 
 
@@ -141,7 +147,7 @@ def eigen_part(name: str, n_dofs: int, n_modes: int, cached_bytes: float | None,
 def setup_part(n_dofs: int, ritz_points: int) -> Part:
     """The rest of a single-ball modal set-up: the band's pulses, the basis' probes and, on
     ``ritz_points`` contact points, the Ritz tail's pre-pass (an FE solve per vector)."""
-    time_s = SETUP_BASE + RITZ_DOF_POINT * n_dofs * ritz_points
+    time_s = SETUP_BASE + RITZ_DOF_POINT * n_dofs**1.5 * ritz_points
     what = f"Ritz tail at {ritz_points} points" if ritz_points else "quasi-static tail"
     return Part("set-up", time_s, MODAL_BASE_MEMORY, what)
 
@@ -181,12 +187,15 @@ def reference_part(n_particles: int, impacts: float) -> Part:
                 f"~{steps:.0f} steps of {n_particles} bodies")  # fmt: skip
 
 
-def replay_part(sensors, duration: float, n_modes: int, top_hz: float, particles: int = 0):
+def replay_part(sensors, duration: float, n_modes: int, top_hz: float, particles: int = 0,
+                ritz_dofs: int = 0):  # fmt: skip
     """Every sensor's chain on its fine grid (``tailbeam.signals.sensor.measure``); a stream's
-    ``particles``: the modal response to their recorded loads."""
+    ``particles``: the modal response to their recorded loads; ``ritz_dofs``: the FE model's
+    DOFs when the basis carries the Ritz tail (its static part at each sensor)."""
     fines = [_fine_samples(s, duration, top_hz) for s in sensors]
     per = REPLAY_SAMPLE + REPLAY_SAMPLE_MODE * n_modes
-    time_s = REPLAY_BASE + REPLAY_SENSOR * len(sensors) + per * sum(fines)
+    per_sensor = REPLAY_SENSOR + REPLAY_SENSOR_MODE * n_modes + REPLAY_RITZ * ritz_dofs**1.5
+    time_s = REPLAY_BASE + per_sensor * len(sensors) + per * sum(fines)
     time_s += REPLAY_PARTICLE_MODE * particles * n_modes
     memory = MODAL_BASE_MEMORY + 8.0 * REPLAY_WORDS * max(fines, default=0)
     what = f"{len(sensors)} sensors, {sum(fines):.3g} fine samples x {n_modes} modes"

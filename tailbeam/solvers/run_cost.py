@@ -76,7 +76,9 @@ def estimate_run(scene, solver, *, band: dict | None = None, writes: bool = True
     if modal_sensors:
         check_replay(scene, n_modes, top_hz)
         particles = len(scene.particles) if solver.stream else 0
-        parts.append(replay_part(scene.sensors, scene.duration, n_modes, top_hz, particles))
+        ritz_dofs = plan.n_dofs if plan.ritz_points else 0
+        parts.append(replay_part(scene.sensors, scene.duration, n_modes, top_hz, particles,
+                                 ritz_dofs))  # fmt: skip
     if writes:
         parts.append(write_part(scene, not solver.stream, modal_sensors))
     return RunCost(tuple(parts), alternative)

@@ -59,7 +59,8 @@ class CoupledRun:
             while st.t < self.duration:
                 if len(self.book.events) > max_events:
                     raise WorkLimitError(
-                        f"more than {max_events} events by t = {st.t:.6g} s; shorten duration"
+                        f"more than max_events = {max_events} events by t = {st.t:.6g} s; "
+                        "shorten duration"
                     )
                 code = self._advance(self._refresh_points(), max_steps)
                 bar.update(1e3 * (st.t - t_shown))
@@ -109,7 +110,8 @@ class CoupledRun:
             self.nodes.grow()
         elif code == K.ST_STEPS:
             raise WorkLimitError(
-                f"more than {max_steps} steps by t = {self.state.t:.6g} s; shorten duration"
+                f"more than max_steps = {max_steps} steps by t = {self.state.t:.6g} s; "
+                "shorten duration"
             )
         elif code == K.ST_FAIL:
             raise WorkLimitError(

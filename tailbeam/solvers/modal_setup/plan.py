@@ -53,6 +53,8 @@ class BasisPlan:
     two_way: bool
     tail_oscillators: int
     alternative: str
+    n_dofs: int = 0
+    ritz_points: int = 0
 
 
 def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
@@ -77,11 +79,12 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
         parts.append(eigen_part("contact tails", t_dofs, t_modes, t_cached,
                                 f"modes to {wide / 1e3:g} kHz"))  # fmt: skip
         tail_k = int(band.get("tail_oscillators", 0))
+    ritz = 0 if stream else _ritz_points(scene, settings, theory)
     if not stream:
-        parts.append(setup_part(dofs, _ritz_points(scene, settings, theory)))
+        parts.append(setup_part(dofs, ritz))
     two_way = settings.coupling == "two-way"
     return BasisPlan(tuple(parts), modes, fmax, two_way, tail_k,
-                     _alternative(scene, settings, band, stream, parts))  # fmt: skip
+                     _alternative(scene, settings, band, stream, parts), dofs, ritz)  # fmt: skip
 
 
 def _ritz_points(scene, settings, theory: str) -> int:
