@@ -20,6 +20,7 @@ from tailbeam.solvers.cost import (
 from tailbeam.solvers.coupled.solver import DEFAULT_REST_SPEED, DEFAULT_STEPS_PER_CONTACT
 from tailbeam.solvers.modal_setup.band import impact_pulse
 from tailbeam.solvers.modal_setup.plan import plan_bases
+from tailbeam.solvers.modal_setup.ritz_prepass import check_tail_scene
 
 
 def expected_impacts(scene, rest_speed: float = DEFAULT_REST_SPEED) -> float:
@@ -67,6 +68,7 @@ def estimate_run(scene, solver, *, band: dict | None = None, writes: bool = True
     parts, alternative, plan = [], "", None
     n_modes, top_hz = 0, 0.0
     if scene.plate_model == "modal":
+        check_tail_scene(scene)  # the set-up's own refusals first
         plan = plan_bases(scene, solver.stream, band)
         parts += plan.parts
         n_modes, top_hz = plan.n_modes, plan.fmax_hz
