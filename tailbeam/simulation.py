@@ -23,6 +23,7 @@ from tailbeam.progress import quiet
 from tailbeam.scene import Scene
 from tailbeam.solvers.base import Options, Solver
 from tailbeam.solvers.modal_setup.setup import single_ball_setup, stream_setup
+from tailbeam.solvers.run_cost import announce_run
 from tailbeam.solvers.single_ball import SingleBall
 from tailbeam.solvers.stream.solver import Stream, StreamReference
 
@@ -62,7 +63,10 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
     options = Options(rtol=rtol, max_steps=max_steps)
     with contextlib.nullcontext() if progress else quiet():
         method.check(scene, options)
-        return method.run(scene, plate_setup(scene, method), options)
+        cost = announce_run(scene, method)
+        result = method.run(scene, plate_setup(scene, method), options)
+    result.info["run_cost_estimate"] = cost.as_dict()
+    return result
 
 
 def choose_solver(scene, solver: str = "auto", field: str = "solver") -> Solver:

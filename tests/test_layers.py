@@ -28,7 +28,7 @@ LEVELS = (
     {"protocol": ("tailbeam.solvers.base",), "modal setup": ("tailbeam.solvers.modal_setup",)},
     {"rigid": ("tailbeam.solvers.rigid",)},
     {"coupled": ("tailbeam.solvers.coupled",), "stream": ("tailbeam.solvers.stream",)},
-    {"single ball": ("tailbeam.solvers.single_ball",)},
+    {"single ball": ("tailbeam.solvers.single_ball",), "run cost": ("tailbeam.solvers.run_cost",)},
     {"simulation": ("tailbeam.simulation",)},
     {"paper": ("tailbeam.paper",), "study": ("tailbeam.study",)},
     {"cli": ("tailbeam.cli",)},

@@ -59,7 +59,8 @@ class CoupledRun:
             while st.t < self.duration:
                 if len(self.book.events) > max_events:
                     raise WorkLimitError(
-                        f"more than max_events={max_events} events; raise max_events"
+                        f"more than max_events = {max_events} events by t = {st.t:.6g} s; "
+                        "shorten duration"
                     )
                 code = self._advance(self._refresh_points(), max_steps)
                 bar.update(1e3 * (st.t - t_shown))
@@ -108,11 +109,15 @@ class CoupledRun:
         if code == K.ST_FULL:
             self.nodes.grow()
         elif code == K.ST_STEPS:
-            raise WorkLimitError(f"more than max_steps={max_steps} steps; raise max_steps")
+            raise WorkLimitError(
+                f"more than max_steps = {max_steps} steps by t = {self.state.t:.6g} s; "
+                "shorten duration"
+            )
         elif code == K.ST_FAIL:
             raise WorkLimitError(
-                f"the contact Newton iteration failed to converge at t = {self.state.t:.9g} s; "
-                "raise steps_per_contact"
+                f"the contact forces could not be solved at t = {self.state.t:.9g} s, even on a "
+                f"step halved {K.MAX_HALVINGS} times (a defect of the solver: please report "
+                "the scene)"
             )
         elif code == K.ST_STOP:
             self._time_limits()

@@ -12,6 +12,10 @@ a step only goes on when the gap of every flying ball is certified positive on t
 by two bounds (|gap'| <= L, and gap'' >= -(g + A) with A a bound on the plate acceleration
 from the modal energies), else the step is bisected. In free flight the step is the certified
 horizon itself, so flights take a few dozen exact jumps, not contact-size steps.
+
+A step whose contact forces are not solved (``step.solve_step``, with its fallback
+``contact_solve.solve_forces``), there or while locating its events, is halved and taken again
+(at most ``MAX_HALVINGS`` times): the smaller the step, the more the contacts decouple.
 """
 
 import math
@@ -24,6 +28,7 @@ from tailbeam.solvers.coupled.step import CLAMPED, CONTACT, FLIGHT, solve_step
 from tailbeam.solvers.numerics.jit import helper_njit
 
 ST_STOP, ST_EVENT, ST_FULL, ST_FAIL, ST_STEPS = range(5)
+MAX_HALVINGS = 30  # of a step whose contact forces are not solved (tau / 1e9)
 
 
 @njit(cache=True)
@@ -392,23 +397,32 @@ def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
         if not in_contact:  # the certified flight horizon
             tau = _flight_step(ctx, st, t_stop - t, h, g, fm)
         tau = min(tau, t_stop - t)
-        for b in range(nb):
-            guess[b] = F[b] + hist[0, b] * tau
-            F1[b] = guess[b]
-        if not solve_step(tau, ctx, st, out, g):
-            return ST_FAIL, t, nbuf, steps
-        # --- events on this step: keep the earliest
+        ok = False
         best, kind_best, b_best = tau, EventCode.NONE, -1
-        L, A = _bounds(ctx, st, f0m, f1m, tau, g)
-        for b in range(nb):
-            nk = _contact_kinds(b, mode, deep, aux, d, clampf, kinds)
-            if nk == 0 and mode[b] != FLIGHT:
-                continue  # (nothing to locate: no tuples handed over, see numerics.jit)
-            ok, best, kind_best, b_best = _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L,
-                                                       A, guess, best, kind_best, b_best, mode,
-                                                       cur, d, kinds, nk)  # fmt: skip
-            if not ok:
-                return ST_FAIL, t, nbuf, steps
+        for _halving in range(MAX_HALVINGS + 1):  # a step whose forces are not solved: halve it
+            for b in range(nb):
+                guess[b] = F[b] + hist[0, b] * tau
+                F1[b] = guess[b]
+            ok = solve_step(tau, ctx, st, out, g)
+            # --- events on this step: keep the earliest
+            best, kind_best, b_best = tau, EventCode.NONE, -1
+            if ok:
+                L, A = _bounds(ctx, st, f0m, f1m, tau, g)
+                for b in range(nb):
+                    nk = _contact_kinds(b, mode, deep, aux, d, clampf, kinds)
+                    if nk == 0 and mode[b] != FLIGHT:
+                        continue  # (nothing to locate: no tuples handed over, see numerics.jit)
+                    ok, best, kind_best, b_best = _ball_events(b, tau, ctx, st, aux, out2,
+                                                               out_best, g, L, A, guess, best,
+                                                               kind_best, b_best, mode, cur, d,
+                                                               kinds, nk)  # fmt: skip
+                    if not ok:
+                        break
+            if ok:
+                break
+            tau *= 0.5
+        if not ok:
+            return ST_FAIL, t, nbuf, steps
         if kind_best != EventCode.NONE:
             # the solution at the located time, exactly as the root finder checked its sign
             tau = best

@@ -106,6 +106,6 @@ def _check_inputs(balls, basis, laws, sensors, residual_flexibility, coupling, s
         raise InputError(
             "plate.residual_flexibility",
             f"the {basis.theory} {basis.boundary} basis has no static compliance (a plate with "
-            "rigid-body modes); set residual_flexibility = false",
+            "rigid-body modes); set plate.residual_flexibility = false",
         )
     return contacts

@@ -131,7 +131,7 @@ class NodeBuffers:
         """A node at time t (s) of ``state``, in row ``phase`` of ``phis``."""
         bt, bz, bvz, bF, bd = self.bufs
         if self.nbuf >= len(bt):
-            raise WorkLimitError("node buffer full at a rest declaration; raise max_steps")
+            raise WorkLimitError("node buffer full at a rest declaration; shorten duration")
         i = self.nbuf
         bt[i], bz[i], bvz[i], bF[i], bd[i] = t, state.z, state.vz, state.F, state.cur[0]
         self.seg_phase.append(phase)

@@ -11,13 +11,16 @@ forces at the step's end solve, by Newton's method on the few active contacts,
 with w_j = sum_i phi_ji q_i the plate under ball j (two-way coupling) and C_j the residual
 compliance of the truncated modes (quasi-static, in series with the contact; its rate term uses
 a variable-step BDF2 derivative of F, so the scheme stays 2nd order). delta_j is linear in the
-unknown end forces, so each Newton iteration costs O(na^2) after one O(na^2 n) set-up.
+unknown end forces, so each Newton iteration costs O(na^2) after one O(na^2 n) set-up. Where
+plain Newton does not converge, ``contact_solve.solve_forces`` solves the same equations
+(damped Newton, then bracketed scalar solves); the kernel halves the step if that fails too.
 """
 
 import numpy as np
 from numba import njit
 
 from tailbeam.physics.impact import force_partials
+from tailbeam.solvers.coupled.contact_solve import solve_forces
 from tailbeam.solvers.numerics.jit import helper_njit
 from tailbeam.solvers.plate_loads.propagator import A1, B1, advance, coefficients
 
@@ -164,7 +167,10 @@ def solve_step(tau, ctx, st, out, g):
         for jj in range(na):
             x[jj] = F1[idx[jj]]  # caller's guess
         if not _newton(idx, na, dfree, vfree, S, Sv, x, k, e, c, d, clampf):
-            return False
+            for jj in range(na):
+                x[jj] = F1[idx[jj]]  # the fallback starts again from the guess
+            if not solve_forces(idx, na, dfree, vfree, S, Sv, x, k, e, c, d, clampf):
+                return False
         for jj in range(na):
             F1[idx[jj]] = x[jj]
             f1m -= phi[idx[jj]] * x[jj]

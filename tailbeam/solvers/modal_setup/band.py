@@ -37,6 +37,7 @@ Cost. Before anything is assembled the basis's DOFs, modes, memory and time are 
 Theory and mesh: tailbeam.plate.compute_modes(theory="auto") picks them from the band.
 """
 
+import functools
 import math
 
 import numpy as np
@@ -104,9 +105,17 @@ def stream_band_estimate(scene: Scene, fmax: float, residual: bool = True) -> di
 
 
 def impact_pulse(mass: float, speed: float, law) -> dict:
+    """``rigid_pulse`` (a copy: the same impact is computed once per process, as the band
+    and the run's cost estimate both ask for it)."""
+    return dict(rigid_pulse(float(mass), float(speed), law))
+
+
+@functools.lru_cache(maxsize=4096)
+def rigid_pulse(mass: float, speed: float, law) -> dict:
     """Force pulse of a ball of ``mass`` (kg) striking a rigid flat at ``speed`` (m/s) under
     the IMPACT ``law``, without gravity: duration_s (s), compliance_m_n = penetration / force
-    at the force peak (m/N), pulse_omega = sqrt(int F'^2 dt / int F^2 dt) (rad/s), exponent."""
+    at the force peak (m/N), pulse_omega = sqrt(int F'^2 dt / int F^2 dt) (rad/s), exponent,
+    restitution (rebound speed / ``speed``: 0 when the impact ends at rest)."""
     from scipy.integrate import solve_ivp
 
     t_hertz = hertz_contact_duration(mass, speed, law.stiffness, law.exponent)
@@ -139,6 +148,7 @@ def impact_pulse(mass: float, speed: float, law) -> dict:
         "compliance_m_n": float(d[peak] / f[peak]),
         "pulse_omega": float(np.sqrt(np.trapezoid(slope**2, t) / np.trapezoid(f**2, t))),
         "exponent": law.exponent,
+        "restitution": float(max(-sol.y[1, -1], 0.0) / speed),
     }
 
 

@@ -297,7 +297,7 @@ def _check_memory(n_points, n_samples, loads, n_modes, batch_nodes, max_bytes):
         raise WorkLimitError(
             f"max_bytes: the plate response needs ~{need / 1e9:.2f} GB ({n_points} points x "
             f"{n_samples} samples, {loads.n_nodes} load nodes), above {max_bytes / 1e9:.2f} GB;"
-            " use fewer samples or points per call, or raise max_bytes"
+            " lower sensors[i].sample_rate or duration"
         )
 
 

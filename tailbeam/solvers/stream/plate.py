@@ -42,7 +42,7 @@ class StreamPlate:
             raise InputError(
                 "plate.residual_flexibility",
                 f"the {basis.theory} {basis.boundary} basis has no static compliance (a plate "
-                "with rigid-body modes); set residual_flexibility = false",
+                "with rigid-body modes); set plate.residual_flexibility = false",
             )
         if tail is not None and not residual_flexibility:
             raise InputError("plate.tail", "'ritz' needs residual_flexibility = true")

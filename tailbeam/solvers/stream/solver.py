@@ -79,11 +79,11 @@ class Stream(Solver):
             )  # fmt: skip
 
     def _announce(self, scene, rtol, max_steps):
-        memory, worst = self.estimate(len(scene.particles), max_steps)
+        memory, _ = self.estimate(len(scene.particles), max_steps)
         note(
             f"{why_stream(scene)}: stream solver = {self.label}, {len(scene.particles)} "
-            f"particles, rtol {rtol:g}, work bound {max_steps} steps (estimated <= "
-            f"{memory / 1e6:.0f} MB, ~{worst:.0f} s or less)"
+            f"particles, rtol {rtol:g}, work bound {max_steps} steps (<= {memory / 1e6:.0f} MB "
+            "at the bound)"
         )
 
 
