@@ -36,23 +36,7 @@ ROW = re.compile(r"^\|\s*`([^`|]+)`\s*\|", re.MULTILINE)
 SIGNATURE = re.compile(r"tailbeam\.simulate\(scene, \*, ([^)]*)\)")
 
 # (module, setting) -> why it is an offender today. Remove an entry when its message is fixed.
-KNOWN = {
-    ("tailbeam/solvers/coupled/driver.py", "steps_per_contact"): (
-        "a keyword of simulate_coupled, not a scene key or option; branch i-robust makes the "
-        "contact iteration robust and removes this message"
-    ),
-    ("tailbeam/solvers/rigid/driver.py", "rest_speed"): (
-        "a keyword of simulate_rigid (docs/rigid-solver.md), not of a scene, the CLI or "
-        "tailbeam.simulate, yet the message reaches `tailbeam simulate`"
-    ),
-    ("tailbeam/solvers/rigid/solver.py", "rest_speed"): (
-        "a keyword of simulate_rigid, as above, advised where the step budget runs out"
-    ),
-    ("tailbeam/solvers/plate_loads/response.py", "quasi_static"): (
-        "a keyword of the plate response call, which the solvers make; no scene key or "
-        "option sets it"
-    ),
-}
+KNOWN: dict = {}
 
 
 def _text(node) -> str:

@@ -286,7 +286,8 @@ def _check_residual_time(seconds_one, count):
         raise WorkLimitError(
             f"quasi_static: the static deflection at {count} distinct load points would take "
             f"~{estimate:.0f} s ({seconds_one * 1e3:.2f} ms each with this basis, limit "
-            f"{MAX_QUASI_STATIC_S:.0f} s); pass quasi_static=False (kept modes only)"
+            f"{MAX_QUASI_STATIC_S:.0f} s); set plate.residual_flexibility = false (the kept modes "
+            "only; quasi_static=False in Python)"
         )
 
 

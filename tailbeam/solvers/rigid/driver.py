@@ -149,8 +149,8 @@ def _contact(st: _BallState, integrate_contact, duration, max_contacts, max_step
     if index > max_contacts:
         raise WorkLimitError(
             f"ball {p.name!r}: more than max_contacts={max_contacts} contacts before "
-            f"t = {tc:.6g} s; raise max_contacts, or rest_speed (now {p.rest_speed} m/s) to "
-            "declare slow bounces at rest sooner"
+            f"t = {tc:.6g} s; raise max_contacts, or shorten duration (bounces slower than "
+            f"rest_speed = {p.rest_speed} m/s count as rest)"
         )
     st.events.append(Event(tc, p.name, EventKind.CONTACT_START, PLATE))
     if p.e_rest > 0.0 and p.excess_energy(0.0, v_in) <= p.e_rest:

@@ -110,8 +110,7 @@ class _KernelIntegrator:
         if status == kernel.ST_STEP_LIMIT:
             raise WorkLimitError(
                 f"ball {p.name!r}: the contact integration reached max_steps (integrator steps "
-                "per ball); raise max_steps, or rest_speed to declare a ball in persistent "
-                "contact at rest sooner"
+                "per ball); raise max_steps, or shorten duration"
             )
         if status == kernel.ST_STEP_TINY:
             raise RuntimeError(f"ball {p.name!r}: contact step size underflow (please report)")
