@@ -1,10 +1,11 @@
 """Bodies that overlap at release are refused before any work.
 
-- Two ``[[balls]]`` overlap when their centres are closer than the sum of their radii by
-  more than ``TOUCH_TOLERANCE`` of that sum (rounding of the written coordinates): touching
-  balls are valid, overlapping ones are not. The solvers start every contact from a gap:
+- Two ``[[balls]]`` overlap when their centres, as floating-point numbers, are closer than
+  the sum of their radii: touching balls are valid, overlapping ones are not, even by the
+  rounding of written decimals (0.116 and 0.176 for two 30 mm balls are 1.4e-17 m too close;
+  the message then says so, ``TOUCH_TOLERANCE``). The solvers start every contact from a gap:
   the stream solver does not see a ball-ball contact that already exists at release (two
-  30 mm balls overlapping by 1e-12 m and approaching at 0.2 m/s pass through each other),
+  30 mm balls overlapping by 1e-17 m and approaching at 0.2 m/s pass through each other),
   and the single-ball solvers refuse a ball below the plate's surface, so a release state
   inside another body has no correct run.
 - A stream particle overlaps a ball when, at its release time, it overlaps that ball on the
@@ -29,7 +30,7 @@ from scipy.spatial import cKDTree
 
 from tailbeam.errors import InputError
 
-TOUCH_TOLERANCE = 1e-9  # of r_i + r_j: an overlap this small is rounding, i.e. touching
+TOUCH_TOLERANCE = 1e-9  # of r_i + r_j: an overlap this small is the rounding of decimals
 MAX_SAMPLES = 100_000  # points per ball path (a longer path is sampled more coarsely)
 TIME_SCALE = 1.0  # m/s: release times become a fourth coordinate c t of the particle tree
 
@@ -51,11 +52,18 @@ def check_ball_pairs(balls) -> None:
     i, j = pairs.min(axis=1), pairs.max(axis=1)
     dist = np.linalg.norm(centres[j] - centres[i], axis=1)
     reach = radii[i] + radii[j]
-    bad = np.flatnonzero(dist < reach * (1.0 - TOUCH_TOLERANCE))
+    bad = np.flatnonzero(dist < reach)
     if len(bad) == 0:
         return
     k = bad[np.lexsort((i[bad], j[bad]))[0]]
     a, b = int(i[k]), int(j[k])
+    if dist[k] >= reach[k] * (1.0 - TOUCH_TOLERANCE):
+        raise InputError(
+            f"balls[{b + 1}].position",
+            f"touches balls[{a + 1}] ({balls[a].name!r}) {reach[k] - dist[k]:.2g} m closer than "
+            f"the sum of their radii, by the rounding of the written decimals; a contact at "
+            "release needs the centres at least r1 + r2 apart: move one away by 1e-9 m",
+        )
     raise InputError(
         f"balls[{b + 1}].position",
         f"overlaps balls[{a + 1}] ({balls[a].name!r}): centres {_f(dist[k])} m apart, radii "
