@@ -1,6 +1,7 @@
-"""A stream delivers its rate: every particle is released at its drawn time, moved to a free
-place of its release volume when a rebounding ball is in the way (tailbeam.solvers.stream.
-driver.heap_events), and a flow the release volume cannot take is refused up front
+"""What a stream delivers is recorded and said: a particle whose release place a rebounding
+ball takes waits (tailbeam.solvers.stream.driver.heap_events), and the run records the
+delivered rate, the late releases and the largest delay against the drawn arrivals
+(tailbeam.streams.delivery); a flow the release volume cannot take is refused up front
 (tailbeam.streams.generator.release_fill)."""
 
 import math
@@ -38,31 +39,22 @@ def run(stream, duration=0.7):
     return scene, tailbeam.simulate(scene, progress=False)
 
 
-def test_crowded_stream_releases_every_particle_at_its_drawn_time():
+def test_crowded_stream_records_what_it_delivered():
+    """The counts against the drawn arrivals (generated afresh: an independent count)."""
     scene, result = run(CROWDED)
-    drawn = generate_particles([CROWDED], INCLINE)  # the Poisson arrivals, drawn afresh
+    drawn = generate_particles([CROWDED], INCLINE)
     n_drawn = sum(CROWDED["start"] <= p.t_release < CROWDED["stop"] for p in drawn)
-    released = [p.t_release for p in result.particles]
-    assert released == [p.t_release for p in drawn]  # no release waits
+    late = [r.t_release - d.t_release for d, r in zip(drawn, result.particles, strict=True)]
+    assert min(late) >= 0.0 and [p.position for p in result.particles] == [
+        p.position for p in drawn
+    ]
     flow = result.info["streams"]["cave"]
-    assert flow["released_in_window"] == flow["drawn_in_window"] == n_drawn
-    assert flow["delivered_rate"] == n_drawn / 0.5
-    assert flow["release_delay_max"] == 0.0 and result.stats["release_delay_max"] == 0.0
-    assert result.stats["postponed_releases"] == 0 and result.stats["late_starts"] == 0
-    moved = [(d, r) for d, r in zip(drawn, result.particles, strict=True)
-             if d.position != r.position]  # fmt: skip
-    assert flow["moved_releases"] == result.stats["moved_releases"] == len(moved) > 0
-    for _d, r in moved:  # the new place lies in the stream's release volume
-        (x, y, z), rad = r.position, r.radius
-        assert -0.3 <= x <= 0.1 and -0.2 <= y <= 0.2
-        assert rad + 0.02 <= z <= rad + 0.1
-
-
-def test_moved_releases_are_deterministic():
-    _, first = run(CROWDED, duration=0.3)
-    _, again = run(CROWDED, duration=0.3)
-    assert first.stats["moved_releases"] > 0
-    assert [p.position for p in first.particles] == [p.position for p in again.particles]
+    in_window = sum(0.0 <= r.t_release < 0.5 for r in result.particles)
+    assert flow["drawn_in_window"] == n_drawn and flow["released_in_window"] == in_window
+    assert flow["delivered_rate"] == in_window / 0.5
+    assert flow["delayed_releases"] == sum(x > 0 for x in late) > 0
+    assert flow["release_delay_max"] == max(late) == result.stats["release_delay_max"]
+    assert result.stats["postponed_releases"] == flow["delayed_releases"]
 
 
 def test_uncrowded_stream_is_released_as_drawn():
@@ -72,10 +64,8 @@ def test_uncrowded_stream_is_released_as_drawn():
     assert [(p.t_release, p.position) for p in result.particles] == [
         (p.t_release, p.position) for p in drawn
     ]
-    assert (
-        result.stats["moved_releases"] == 0
-        and result.info["streams"]["cave"]["release_delay_max"] == 0.0
-    )
+    flow = result.info["streams"]["cave"]
+    assert flow["delayed_releases"] == 0 and flow["release_delay_max"] == 0.0
 
 
 def test_drawn_count_is_poisson():
@@ -106,11 +96,11 @@ def test_delivery_counts_by_hand():
     drawn = generate_particles([CROWDED], INCLINE)[:4]
 
     late = [drawn[0], replace(drawn[1], t_release=drawn[1].t_release + 0.2),
-            replace(drawn[2], position=(0.0, 0.0, 0.5)),
+            drawn[2],
             replace(drawn[3], t_release=0.6)]  # fmt: skip
     d = delivery([s], drawn, late, duration=1.0)["cave"]
     assert d["drawn_in_window"] == 4 and d["released_in_window"] == 3
-    assert d["delivered_rate"] == 3 / 0.5 and d["moved_releases"] == 1
+    assert d["delivered_rate"] == 3 / 0.5 and d["delayed_releases"] == 2
     assert d["release_delay_max"] == pytest.approx(0.6 - drawn[3].t_release, abs=1e-15)
 
 

@@ -1,7 +1,7 @@
 """What a stream delivered: its releases in its window against what it was asked for.
 
-A solver may release a particle later than drawn (no free place in the release volume at its
-time) or at another place of the volume; ``delivery`` compares the particles as released with
+A solver releases a particle later than drawn when a ball already there (a rebound) would
+overlap it; ``delivery`` compares the particles as released with
 those drawn, per stream:
 
     rate                 the requested rate, particles/s
@@ -11,7 +11,7 @@ those drawn, per stream:
     released_in_window   particles actually released in the window
     delivered_rate       released_in_window / (end - start), particles/s
     release_delay_max    largest delay of a release after its drawn time, s
-    moved_releases       particles released at another place of the release volume
+    delayed_releases     particles released after their drawn time
 """
 
 import math
@@ -45,7 +45,7 @@ def delivery(streams, drawn, released, duration: float) -> dict:
             "released_in_window": in_window,
             "delivered_rate": in_window / (t1 - t0) if t1 > t0 else math.nan,
             "release_delay_max": float(np.max(t_real - t_drawn, initial=0.0)),
-            "moved_releases": sum(d.position != r.position for d, r in pairs),
+            "delayed_releases": int(np.count_nonzero(t_real > t_drawn)),
         }
     return out
 
@@ -56,6 +56,6 @@ def delivery_line(name: str, d: dict) -> str:
     return (
         f"stream {name}: delivered {d['delivered_rate']:.4g} particles/s of the {d['rate']:g} "
         f"asked ({d['released_in_window']} released in [{t0:g}, {t1:g}) s, "
-        f"{d['drawn_in_window']} drawn); {d['moved_releases']} moved to a free place of the "
-        f"release volume, largest release delay {d['release_delay_max']:.3g} s"
+        f"{d['drawn_in_window']} drawn); {d['delayed_releases']} released late, largest "
+        f"release delay {d['release_delay_max']:.3g} s"
     )
