@@ -18,8 +18,8 @@ pytest.importorskip("h5py")
 
 from tailbeam.cli.main import main  # noqa: E402
 from tailbeam.errors import InputError  # noqa: E402
+from tailbeam.study.recordings.formats.readers import open_recording  # noqa: E402
 from tailbeam.study.recordings.onsets import OnsetDetector, OnsetOptions  # noqa: E402
-from tailbeam.study.recordings.readers import open_recording  # noqa: E402
 from tailbeam.study.recordings.resample import Resampler, ratio  # noqa: E402
 
 G = 9.80665

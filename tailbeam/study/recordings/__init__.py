@@ -1,10 +1,8 @@
 """Measured accelerometer recordings into the dataset layout of a sweep (``tailbeam import``).
 
-- ``recording``: what a reader gives: channel names, sample rate and units as the file says
-  them, and the samples block by block;
-- ``wav``, ``csvfile``, ``uff``, ``tdms``, ``matfile``, ``hdf5``: one reader per format, with
-  ``arrays`` (the rule that turns the variables of a MAT or HDF5 file into channels) and
-  ``readers`` (which reader opens which file extension);
+- ``formats``: one reader per file format, each giving a ``Recording`` (channel names, rate
+  and units as the file says them, samples block by block), and which reader opens which
+  file extension;
 - ``units``: acceleration units and their factors to m/s^2;
 - ``labels``: the labels file, one row per recording;
 - ``resample``: block-wise rational resampling (scipy.signal.resample_poly);

@@ -13,8 +13,8 @@ from tailbeam._version import __version__
 from tailbeam.errors import InputError
 from tailbeam.progress import task
 from tailbeam.study.recordings.cut import FileCut, FixedCut, Framer, ImpactCut
+from tailbeam.study.recordings.formats.readers import open_recording
 from tailbeam.study.recordings.onsets import OnsetDetector
-from tailbeam.study.recordings.readers import open_recording
 from tailbeam.study.recordings.resample import Resampler
 from tailbeam.study.recordings.store import SignalWriter, json_attr, write_coordinates, write_tables
 

@@ -11,9 +11,9 @@ import numpy as np
 
 from tailbeam.errors import InputError
 from tailbeam.study.recordings.cut import CUTS
+from tailbeam.study.recordings.formats.readers import open_recording
 from tailbeam.study.recordings.labels import Row, read_labels
 from tailbeam.study.recordings.onsets import OnsetOptions
-from tailbeam.study.recordings.readers import open_recording
 from tailbeam.study.recordings.resample import ratio
 from tailbeam.study.recordings.units import factor, same_unit
 

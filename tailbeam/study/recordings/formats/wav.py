@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam.errors import InputError
-from tailbeam.study.recordings.recording import Recording
+from tailbeam.study.recordings.formats.recording import Recording
 
 FULL_SCALE = {"int16": 2.0**15, "int32": 2.0**31, "uint8": 128.0}
 

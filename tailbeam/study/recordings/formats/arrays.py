@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tailbeam.errors import InputError
-from tailbeam.study.recordings.recording import check_channels, rate_from_times
+from tailbeam.study.recordings.formats.recording import check_channels, rate_from_times
 
 RATE_NAMES = ("fs", "sample_rate", "sampling_rate", "sample_rate_hz")
 STEP_NAMES = ("dt", "wf_increment")

@@ -1,5 +1,5 @@
 """HDF5 files (h5py, streamed). Datasets become channels by the rule of
-tailbeam.study.recordings.arrays; attributes of a dataset, the groups above it and the file
+tailbeam.study.recordings.formats.arrays; attributes of a dataset, the groups above it and the file
 give its rate and unit. A MATLAB v7.3 file is read the same way (its text variables are
 MATLAB ``char`` arrays; the ``#refs#`` group is skipped)."""
 
@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam.errors import InputError
-from tailbeam.study.recordings.arrays import Variable, channels
-from tailbeam.study.recordings.recording import Recording
+from tailbeam.study.recordings.formats.arrays import Variable, channels
+from tailbeam.study.recordings.formats.recording import Recording
 
 
 def _attrs(obj) -> dict:

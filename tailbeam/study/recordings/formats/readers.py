@@ -3,41 +3,41 @@
 from pathlib import Path
 
 from tailbeam.errors import InputError
-from tailbeam.study.recordings.recording import Recording
+from tailbeam.study.recordings.formats.recording import Recording
 
 
 def _wav(path):
-    from tailbeam.study.recordings.wav import open_wav
+    from tailbeam.study.recordings.formats.wav import open_wav
 
     return open_wav(path)
 
 
 def _csv(path):
-    from tailbeam.study.recordings.csvfile import open_csv
+    from tailbeam.study.recordings.formats.csvfile import open_csv
 
     return open_csv(path)
 
 
 def _uff(path):
-    from tailbeam.study.recordings.uff import open_uff
+    from tailbeam.study.recordings.formats.uff import open_uff
 
     return open_uff(path)
 
 
 def _tdms(path):
-    from tailbeam.study.recordings.tdms import open_tdms
+    from tailbeam.study.recordings.formats.tdms import open_tdms
 
     return open_tdms(path)
 
 
 def _mat(path):
-    from tailbeam.study.recordings.matfile import open_mat
+    from tailbeam.study.recordings.formats.matfile import open_mat
 
     return open_mat(path)
 
 
 def _hdf5(path):
-    from tailbeam.study.recordings.hdf5 import open_hdf5
+    from tailbeam.study.recordings.formats.hdf5 import open_hdf5
 
     return open_hdf5(path)
 

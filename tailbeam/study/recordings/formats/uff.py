@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam.errors import InputError
-from tailbeam.study.recordings.recording import Recording, check_channels
+from tailbeam.study.recordings.formats.recording import Recording, check_channels
 
 TIME_ABSCISSA = (0, 17)  # unknown, time
 

@@ -6,7 +6,7 @@ rate and the length."""
 from pathlib import Path
 
 from tailbeam.errors import InputError
-from tailbeam.study.recordings.recording import Recording, check_channels
+from tailbeam.study.recordings.formats.recording import Recording, check_channels
 
 
 def _channels(tdms) -> list:

@@ -1,13 +1,13 @@
 """MATLAB files: v4 to v7 with scipy.io.loadmat (read whole), v7.3 (an HDF5 file) with h5py,
-streamed. Variables become channels by the rule of tailbeam.study.recordings.arrays."""
+streamed. Variables become channels by the rule of tailbeam.study.recordings.formats.arrays."""
 
 from pathlib import Path
 
 import numpy as np
 
 from tailbeam.errors import InputError
-from tailbeam.study.recordings.arrays import Variable, channels
-from tailbeam.study.recordings.recording import Recording
+from tailbeam.study.recordings.formats.arrays import Variable, channels
+from tailbeam.study.recordings.formats.recording import Recording
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
@@ -38,7 +38,7 @@ def _variables_v5(path: Path) -> list:
 
 def open_mat(path: Path) -> Recording:
     if _is_v73(path):
-        from tailbeam.study.recordings.hdf5 import open_hdf5
+        from tailbeam.study.recordings.formats.hdf5 import open_hdf5
 
         rec = open_hdf5(path, matlab=True)
         rec.reader = "mat v7.3 (h5py)"

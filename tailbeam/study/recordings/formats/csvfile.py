@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam.errors import InputError
-from tailbeam.study.recordings.recording import Recording, check_channels, rate_from_times
+from tailbeam.study.recordings.formats.recording import Recording, check_channels, rate_from_times
 
 TIME_NAMES = ("time", "t", "time_s", "time[s]", "time(s)")
 UNIT_IN_NAME = re.compile(r"^(.*?)\s*[\[(]\s*([^\])]+?)\s*[\])]\s*$")
