@@ -17,7 +17,6 @@ from tailbeam.physics.incline import InclinedPlate
 from tailbeam.streams.delivery import delivery
 from tailbeam.streams.generator import (
     MAX_FILL,
-    ReleaseSlot,
     generate_particles,
     parse_stream,
     release_fill,
@@ -79,16 +78,6 @@ def test_drawn_count_is_poisson():
     mean = 40.0 * 0.5
     assert abs(np.mean(counts) - mean) < 4 * math.sqrt(mean / len(counts))
     assert np.var(counts, ddof=1) == pytest.approx(mean, rel=0.35)  # 3.5 standard errors
-
-
-def test_slot_candidates_depend_on_seed_and_number_only():
-    a = ReleaseSlot(((-0.3, 0.1), (-0.2, 0.2)), (0.02, 0.1), 5, 7, 50)
-    same = ReleaseSlot(((-0.3, 0.1), (-0.2, 0.2)), (0.02, 0.1), 5, 7, 50)
-    np.testing.assert_array_equal(a.candidates(0.02), same.candidates(0.02))
-    other = ReleaseSlot(((-0.3, 0.1), (-0.2, 0.2)), (0.02, 0.1), 5, 8, 50)
-    assert not np.any(a.candidates(0.02) == other.candidates(0.02))
-    c = a.candidates(0.02)
-    assert c.shape == (50, 3) and np.all(c[:, 2] >= 0.04) and np.all(c[:, 2] <= 0.12)
 
 
 def test_delivery_counts_by_hand():
