@@ -208,7 +208,7 @@ def visualize(rows: list, path) -> Path:
     )
     colours = {"nominal": "tab:blue", "randomised": "tab:purple", "plates": "tab:brown",
                "h12": "tab:orange", "cccc": "tab:green"}  # fmt: skip
-    fig, ax = plt.subplots(figsize=(max(12.0, 0.6 * len(groups)), 5.6), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(max(12.0, 0.8 * len(groups)), 5.6), constrained_layout=True)
     width, seen = 0.2, set()
     for i, g in enumerate(groups):
         bars = [r for r in mine if (r["model"], r["sensors"], r["training"], r["normalise"]) == g]
