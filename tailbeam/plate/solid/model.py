@@ -1,0 +1,168 @@
+"""The assembled structure: a volume mesh, its elasticity, supports and impact face, as the
+reduced matrices K q'' ... of its held DOFs (u = T q), the operators that read displacements
+at the impact face and anywhere on the surface, and static solves.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from tailbeam.errors import InputError, require_nonnegative
+from tailbeam.physics.materials import CARBON_STEEL, Material
+from tailbeam.physics.contact_patch import disc_rule
+from tailbeam.plate.fe.sparse_solve import SymmetricSolver
+from tailbeam.plate.solid.elasticity import assemble_elasticity
+from tailbeam.plate.solid.impact_face import ImpactFace, impact_face
+from tailbeam.plate.solid.probe import displacement_operator
+from tailbeam.plate.solid.supports import (
+    Support,
+    apply_supports,
+    check_support,
+    free_rigid_motions,
+)
+from tailbeam.plate.solid.surface import Surface, surface_of
+from tailbeam.plate.solid.volume_mesh import VolumeMesh, read_volume_mesh
+
+SUPPORTS_FIELD = "plate.supports"
+
+
+@dataclass(eq=False)
+class StructureModel:
+    """A held (or deliberately free) linear elastic structure.
+
+    stiffness, mass : (n, n) CSR on the reduced DOFs q (u = transform @ q), N/m and kg.
+    rigid_modes : rigid-body motions left free (0 unless built with ``free=True``).
+    """
+
+    vmesh: VolumeMesh
+    face: ImpactFace
+    basis: object
+    element: str
+    stiffness: sp.csr_matrix
+    mass: sp.csr_matrix
+    transform: sp.csr_matrix
+    rigid_modes: int
+    supports: tuple
+    _surface: Surface | None = field(default=None, repr=False)
+    _solver: SymmetricSolver | None = field(default=None, repr=False)
+
+    @property
+    def plate(self):
+        return self.face.plate
+
+    @property
+    def n_dofs(self) -> int:
+        return int(self.stiffness.shape[0])
+
+    def face_operator(self, points) -> sp.csr_matrix:
+        """(p, n) z-displacement (m) at impact-face points (p, 2) from reduced vectors."""
+        pts = _face_points(self.plate, points)
+        cells = self.face.cells_at(pts)
+        xyz = np.column_stack([pts, np.zeros(len(pts))])
+        dirs = np.tile([0.0, 0.0, 1.0], (len(pts), 1))
+        return (displacement_operator(self.basis, xyz, cells, dirs) @ self.transform).tocsr()
+
+    def surface(self) -> Surface:
+        if self._surface is None:
+            self._surface = surface_of(self.vmesh.mesh)
+        return self._surface
+
+    def surface_operator(self, points, directions=None, field_name="sensors") -> sp.csr_matrix:
+        """(p, n) displacement (m) along ``directions`` (p, 3; default the outward surface
+        normal there) at surface points (p, 3) from reduced vectors; InputError naming
+        ``field_name`` for a point off the surface."""
+        xyz, cells, normals = self.surface().locate(points, field_name)
+        if directions is None:
+            dirs = normals
+        else:
+            dirs = np.atleast_2d(np.asarray(directions, dtype=float))
+            norm = np.linalg.norm(dirs, axis=1, keepdims=True)
+            if dirs.shape != xyz.shape or np.any(norm == 0):
+                raise InputError(field_name, "directions must be nonzero (x, y, z) vectors")
+            dirs = dirs / norm
+        return (displacement_operator(self.basis, xyz, cells, dirs) @ self.transform).tocsr()
+
+    def load_vector(self, point, contact_radius: float = 0.0) -> np.ndarray:
+        """(n,) generalised load of 1 N along +z spread uniformly over a disc of
+        ``contact_radius`` m about the impact-face point (x, y)."""
+        radius = require_nonnegative("contact_radius", contact_radius)
+        centre = _face_points(self.plate, point)[0]
+        pts, weights = disc_rule(self.plate, centre, radius)
+        return np.asarray(self.face_operator(pts).T @ weights).ravel()
+
+    def solver(self) -> SymmetricSolver:
+        if self.rigid_modes:
+            raise InputError(SUPPORTS_FIELD, "a free structure has no static compliance")
+        if self._solver is None:
+            self._solver = SymmetricSolver(self.stiffness)
+        return self._solver
+
+    def static_compliance(self, points, contact_radius: float = 0.0) -> np.ndarray:
+        """(p,) mean z-deflection (m/N) over the disc under 1 N spread over it."""
+        pts = _face_points(self.plate, points)
+        out = np.empty(len(pts))
+        for i, p in enumerate(pts):
+            f = self.load_vector(p, contact_radius)
+            out[i] = f @ self.solver().solve(f)
+        return out
+
+    def static_deflection(self, load_point, points, contact_radius: float = 0.0) -> np.ndarray:
+        """(p,) z-deflection (m/N) at impact-face ``points`` under 1 N at ``load_point``."""
+        f = self.load_vector(load_point, contact_radius)
+        return np.asarray(self.face_operator(points) @ self.solver().solve(f)).ravel()
+
+
+def _face_points(plate, points) -> np.ndarray:
+    """(p, 2) points of the impact face's rectangle, else InputError."""
+    from tailbeam.plate.fe.model import check_points
+
+    return check_points(plate, points)
+
+
+def assemble_structure(
+    mesh,
+    impact_face_name: str,
+    supports=(),
+    *,
+    material: Material = CARBON_STEEL,
+    free: bool = False,
+) -> StructureModel:
+    """Assemble a structure from a volume mesh (a path, or a VolumeMesh).
+
+    Parameters
+    ----------
+    mesh : str, Path or VolumeMesh
+        The volume mesh (``plate.mesh``).
+    impact_face_name : str
+        The named flat face in z = 0 where particles land (``plate.impact_face``).
+    supports : sequence of Support
+        ``plate.supports[1]``, ... in order.
+    material : Material
+        Of the whole structure (E Pa, nu, rho kg/m^3).
+    free : bool
+        Allow rigid-body motions (a free structure); else a structure the supports do not
+        hold is refused.
+    """
+    vmesh = mesh if isinstance(mesh, VolumeMesh) else read_volume_mesh(mesh)
+    face = impact_face(vmesh, impact_face_name, material)
+    fields = [f"{SUPPORTS_FIELD}[{i}]" for i in range(1, len(supports) + 1)]
+    supports = tuple(check_support(s, f) for s, f in zip(supports, fields, strict=True))
+    elastic = assemble_elasticity(vmesh.mesh, vmesh.kind, material)
+    cons = apply_supports(elastic.basis, vmesh, supports, fields)
+    rigid = free_rigid_motions(elastic.basis, cons)
+    if rigid and not free:
+        said = "no supports" if not supports else "these supports"
+        raise InputError(
+            SUPPORTS_FIELD,
+            f"the structure is not held: {rigid} rigid-body motion(s) stay free with {said}; "
+            "add supports, or ask for a free structure",
+        )
+    t = cons.transform
+    k = (t.T @ ((elastic.stiffness + cons.spring) @ t)).tocsr()
+    m = (t.T @ (elastic.mass @ t)).tocsr()
+    return StructureModel(vmesh, face, elastic.basis, elastic.element, k, m, t, rigid,
+                          supports)  # fmt: skip
+
+
+__all__ = ["StructureModel", "Support", "assemble_structure"]

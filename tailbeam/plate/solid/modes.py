@@ -1,0 +1,132 @@
+"""A structure's modes below a frequency (or the first few) as a ``ModalBasis``.
+
+The number of modes below fmax comes first, exactly, from Sylvester's inertia of
+K - (2 pi fmax)^2 M (``tailbeam.plate.fe.sparse_solve``); then that many lowest eigenpairs
+(plus a margin of two) by shift-invert Lanczos at a shift below every eigenvalue, the same
+solver as the flat plate's. Rigid-body modes of a free structure are dropped. Shapes are
+unit-modal-mass; the basis reads them as the z-displacement of the impact face
+(``deflection_at``, the contract every solver uses) and along any direction at any surface
+point (``shape_at``, for sensors anywhere).
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from tailbeam.errors import InputError, WorkLimitError, require_positive
+from tailbeam.plate.basis import ModalBasis
+from tailbeam.plate.fe.sparse_solve import count_eigenvalues_below, lowest_modes
+from tailbeam.plate.solid.model import StructureModel
+from tailbeam.progress import task
+
+THEORY = "solid"
+MARGIN = 2  # modes solved beyond the counted band, so its top is not the Lanczos edge
+
+
+@dataclass(frozen=True, eq=False)
+class StructureModalBasis(ModalBasis):
+    """A ModalBasis of a solid structure, with ``mode_vectors`` (n_dofs, n) on the reduced
+    DOFs (Phi^T M Phi = I) and ``model``, the StructureModel they belong to."""
+
+    mode_vectors: np.ndarray | None = None
+    model: StructureModel | None = field(default=None, repr=False)
+
+    def shape_at(self, points, directions=None, field_name: str = "sensors") -> np.ndarray:
+        """(p, n) modal displacements (1/sqrt(kg)) at surface points (p, 3) m along
+        ``directions`` (p, 3; default the outward surface normal); InputError naming
+        ``field_name`` for a point off the surface."""
+        op = self.model.surface_operator(points, directions, field_name)
+        return np.asarray(op @ self.mode_vectors)[:, : self.n_modes]
+
+
+def _shift(model: StructureModel, fmax_hz: float | None) -> float:
+    """A shift below every eigenvalue (negative), small next to the band's."""
+    if fmax_hz is not None:
+        return -((2.0 * np.pi * 1e-3 * fmax_hz) ** 2)
+    ratio = model.stiffness.diagonal() / np.maximum(model.mass.diagonal(), 1e-300)
+    return -1e-9 * float(np.median(ratio))
+
+
+def solve_band(model: StructureModel, fmax_hz=None, count=None, on_solve=None):
+    """(frequencies Hz (k,), unit-modal-mass vectors (n, k)) of the elastic modes below
+    ``fmax_hz`` and/or the first ``count``."""
+    rigid = model.rigid_modes
+    wanted = count
+    if fmax_hz is not None:
+        below = count_eigenvalues_below(model.stiffness, model.mass, (2 * np.pi * fmax_hz) ** 2)
+        wanted = below - rigid if count is None else min(count, below - rigid)
+        if wanted < 1:
+            raise InputError("fmax_hz", f"no elastic mode lies below {fmax_hz!r} Hz")
+    nev = min(wanted + rigid + MARGIN, model.n_dofs)
+    lam, phi = lowest_modes(model.stiffness, model.mass, nev, shift=_shift(model, fmax_hz),
+                            on_solve=on_solve)  # fmt: skip
+    lam, phi = lam[rigid:], phi[:, rigid:]
+    freqs = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * np.pi)
+    if fmax_hz is not None and np.count_nonzero(freqs <= fmax_hz) < wanted:
+        raise WorkLimitError(
+            f"the eigen-solver found {np.count_nonzero(freqs <= fmax_hz)} of the {wanted} "
+            f"modes below {fmax_hz} Hz"
+        )
+    return freqs[:wanted], _signed(phi[:, :wanted])
+
+
+def _signed(phi: np.ndarray) -> np.ndarray:
+    """Columns with a reproducible sign: the largest entry of each is positive."""
+    big = np.argmax(np.abs(phi), axis=0)
+    signs = np.sign(phi[big, np.arange(phi.shape[1])])
+    return phi * np.where(signs == 0, 1.0, signs)
+
+
+def structure_modes(model: StructureModel, *, fmax_hz=None, count=None, blas_threads=1):
+    """The elastic modes of ``model`` below ``fmax_hz`` (Hz) and/or the first ``count``, as a
+    StructureModalBasis (theory 'solid'); the static compliance of the held structure backs
+    the residual flexibility."""
+    if fmax_hz is None and count is None:
+        raise InputError("fmax_hz", "give fmax_hz or count")
+    if fmax_hz is not None:
+        fmax_hz = require_positive("fmax_hz", fmax_hz)
+    t0 = time.perf_counter()
+    with threadpool_limits(limits=blas_threads), task("eigen-solve", unit="solves") as bar:
+        freqs, phi = solve_band(model, fmax_hz, count, on_solve=bar.update)
+    info = _describe(model, fmax_hz, count, time.perf_counter() - t0)
+
+    def deflection_at(points):
+        return np.asarray(model.face_operator(points) @ phi)
+
+    held = model.rigid_modes == 0
+    return StructureModalBasis(
+        plate=model.plate,
+        frequencies_hz=freqs,
+        deflection_at=deflection_at,
+        theory=THEORY,
+        boundary=_boundary(model),
+        static_compliance_at=model.static_compliance if held else None,
+        static_deflection_at=model.static_deflection if held else None,
+        info=info,
+        mode_vectors=phi,
+        model=model,
+    )
+
+
+def _boundary(model: StructureModel) -> str:
+    """The supports in a few words, e.g. 'pinned hinge, spring jack'."""
+    if not model.supports:
+        return "free"
+    return ", ".join(f"{s.kind} {s.group or 'region'}" for s in model.supports)
+
+
+def _describe(model: StructureModel, fmax_hz, count, seconds) -> dict:
+    return {
+        "theory": THEORY,
+        "element": model.element,
+        "mesh": model.vmesh.source,
+        "n_cells": int(model.vmesh.mesh.t.shape[1]),
+        "n_dofs": model.n_dofs,
+        "impact_face": model.face.name,
+        "fmax_hz": fmax_hz,
+        "count": count,
+        "rigid_body_modes_excluded": model.rigid_modes,
+        "eigensolve_s": seconds,
+    }
