@@ -4,24 +4,26 @@ physical surfaces, so the tests read them through the same path as a user's file
 
 import meshio
 import numpy as np
-from skfem import MeshHex
+from skfem import MeshHex, MeshTet
 from skfem.io.meshio import to_meshio
 
 
-def box_mesh(path, xs, ys, zs, faces, keep=None):
-    """Write a hexahedral mesh of the grid xs x ys x zs (m) to ``path``.
+def box_mesh(path, xs, ys, zs, faces, keep=None, cell=MeshHex):
+    """Write a hexahedral (``cell`` MeshHex) or tetrahedral (MeshTet) mesh of the grid
+    xs x ys x zs (m) to ``path``.
 
-    faces: name -> predicate(centroid (3,), normal (3,)) -> bool on boundary quads;
+    faces: name -> predicate(centroid (3,), normal (3,)) -> bool on boundary facets;
     keep: predicate(cell centroid (3,)) -> bool (default all cells).
     """
-    mesh = MeshHex.init_tensor(np.asarray(xs), np.asarray(ys), np.asarray(zs))
+    mesh = cell.init_tensor(np.asarray(xs), np.asarray(ys), np.asarray(zs))
     if keep is not None:
         centroids = mesh.p[:, mesh.t].mean(axis=1).T
         drop = np.flatnonzero([not keep(c) for c in centroids])
         if len(drop):
             mesh = mesh.remove_elements(drop)
     out = to_meshio(mesh)
-    hexes = out.cells_dict["hexahedron"]
+    volume, facet = ("hexahedron", "quad") if cell is MeshHex else ("tetra", "triangle")
+    hexes = out.cells_dict[volume]
     boundary = mesh.boundary_facets()
     owner = mesh.f2t[0, boundary]
     quads, tags = [], []
@@ -31,15 +33,20 @@ def box_mesh(path, xs, ys, zs, faces, keep=None):
         for f, cell in zip(boundary, owner, strict=True):
             nodes = mesh.facets[:, f]
             c = mesh.p[:, nodes].mean(axis=1)
-            normal = c - mesh.p[:, mesh.t[:, cell]].mean(axis=1)
+            x = mesh.p[:, nodes]
+            normal = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+            if np.linalg.norm(normal) == 0:  # quad corners 0, 1, 2 on a line: use another
+                normal = np.cross(x[:, 2] - x[:, 0], x[:, 3] - x[:, 0])
+            outward = c - mesh.p[:, mesh.t[:, cell]].mean(axis=1)
+            normal = normal * np.sign(normal @ outward)
             normal = np.round(normal / np.linalg.norm(normal), 6)
             if pred(c, normal):
                 quads.append(nodes)
                 tags.append(tag)
-    cells = [("hexahedron", hexes)]
+    cells = [(volume, hexes)]
     phys = [np.full(len(hexes), len(faces) + 1)]
     if quads:
-        cells.insert(0, ("quad", np.array(quads)))
+        cells.insert(0, (facet, np.array(quads)))
         phys.insert(0, np.array(tags))
     written = meshio.Mesh(
         out.points,
@@ -51,13 +58,19 @@ def box_mesh(path, xs, ys, zs, faces, keep=None):
     return path
 
 
-def plate_mesh(path, size=0.6, thickness=0.01, divisions=24, layers=1):
-    """The flat plate (size x size x thickness m, top at z = 0) with faces 'top', 'sides'."""
+def plate_mesh(path, size=0.6, thickness=0.01, divisions=24, layers=1, cell=MeshHex):
+    """The flat plate (size x size x thickness m, top at z = 0) with faces 'top', 'sides',
+    'bottom'."""
     xs = np.linspace(-0.5 * size, 0.5 * size, divisions + 1)
     zs = np.linspace(-thickness, 0.0, layers + 1)
     faces = {"top": lambda c, n: n[2] > 0.5, "sides": lambda c, n: abs(n[2]) < 0.5,
              "bottom": lambda c, n: n[2] < -0.5}  # fmt: skip
-    return box_mesh(path, xs, xs, zs, faces)
+    return box_mesh(path, xs, xs, zs, faces, cell=cell)
+
+
+def tet_plate_mesh(path, **kwargs):
+    """``plate_mesh`` in tetrahedra (each grid cell cut in six)."""
+    return plate_mesh(path, cell=MeshTet, **kwargs)
 
 
 def box_beam_mesh(path, length, width, height, wall, cells_x, cells_y=4, cells_z=2):

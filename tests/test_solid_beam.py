@@ -1,12 +1,12 @@
 """A thin-walled box beam as a solid (tailbeam.plate.solid) against beam theory.
 
 Truths: Timoshenko beam theory solved exactly (the 4x4 transfer matrix of its ODEs, a
-matrix exponential by eigen-decomposition, roots by brentq: no discretisation), with Cowper's shear coefficient of a
-thin-walled box; Euler-Bernoulli as the same equations with no shear or rotary inertia; Bredt's
-thin-walled torsion constant with Saint-Venant's free-warping torsion. Each solid frequency must
-lie within the difference between the theories: |solid/Timoshenko - 1| <= |Timoshenko/EB - 1|
-for bending; for torsion, within the order t/d of Bredt's thin-wall approximation (d the
-smaller midline side).
+matrix exponential by eigen-decomposition, roots by brentq: no discretisation), with
+Cowper's shear coefficient of a thin-walled box; Euler-Bernoulli as the same equations with
+no shear or rotary inertia; Bredt's thin-walled torsion constant with Saint-Venant's
+free-warping torsion. Each solid frequency must lie within the difference between the
+theories: |solid/Timoshenko - 1| <= |Timoshenko/EB - 1| for bending; for torsion, within the
+order t/d of Bredt's thin-wall approximation (d the smaller midline side).
 """
 
 import numpy as np

@@ -43,8 +43,8 @@ def test_impact_face_missing_or_not_flat_at_z0(small_plate):
 
 
 def test_support_group_missing(small_plate):
-    said = _refused("plate.supports[2].group", assemble_structure, small_plate, "top",
-                    [Support("clamped", group="sides"), Support("pinned", group="hinge")])  # fmt: skip
+    supports = [Support("clamped", group="sides"), Support("pinned", group="hinge")]
+    said = _refused("plate.supports[2].group", assemble_structure, small_plate, "top", supports)
     assert "'hinge'" in said
     _refused("plate.supports[1].region", assemble_structure, small_plate, "top",
              [Support("clamped", region=[[5, 6], [0, 1], [0, 1]])])  # fmt: skip

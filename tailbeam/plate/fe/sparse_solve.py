@@ -54,13 +54,14 @@ class SymmetricSolver:
         return int(np.count_nonzero(self._lu.U.diagonal() < 0.0))
 
 
-def lowest_modes(stiffness, mass, count: int, *, shift: float, on_solve=None):
+def lowest_modes(stiffness, mass, count: int, *, shift: float, on_solve=None, factorize=None):
     """The ``count`` smallest eigenpairs of K phi = lambda M phi (lambda = omega^2, rad^2/s^2).
 
     shift: a value below the smallest eigenvalue (negative when there are rigid-body
     modes), so that K - shift M is positive definite. on_solve: called with 1 after each
-    shift-invert solve (progress). Returns (lambda (count,), phi
-    (n, count)) with phi^T M phi = I, sorted by lambda.
+    shift-invert solve (progress). factorize: the factorisation class (default
+    SymmetricSolver; a solid structure passes its nested-dissection one). Returns
+    (lambda (count,), phi (n, count)) with phi^T M phi = I, sorted by lambda.
     """
     n = stiffness.shape[0]
     if count < 1:
@@ -77,17 +78,17 @@ def lowest_modes(stiffness, mass, count: int, *, shift: float, on_solve=None):
     if n <= DENSE_LIMIT:
         lam, phi = sla.eigh(stiffness.toarray(), mass.toarray(), subset_by_index=[0, count - 1])
     else:
-        solver = SymmetricSolver(stiffness - shift * mass)
+        solver = (factorize or SymmetricSolver)(stiffness - shift * mass)
         lam, phi = _eigsh(stiffness, mass, count, shift, solver, on_solve)
     return _unit_modal_mass(lam, phi, mass)
 
 
-def count_eigenvalues_below(stiffness, mass, value: float) -> int:
+def count_eigenvalues_below(stiffness, mass, value: float, factorize=None) -> int:
     """How many eigenvalues of K phi = lambda M phi lie below ``value`` (rad^2/s^2), by
     Sylvester's law of inertia: the number of negative pivots of an LDL^T-type
     factorisation of K - value M (SuperLU without pivoting keeps it symmetric). Independent
     of the eigensolver, so it catches modes the Lanczos iteration might miss."""
-    return SymmetricSolver(stiffness - value * mass).negative_pivots()
+    return (factorize or SymmetricSolver)(stiffness - value * mass).negative_pivots()
 
 
 def _eigsh(stiffness, mass, count, sigma, solver, on_solve=None):

@@ -12,15 +12,15 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, ElementHex2, ElementTetP2, ElementVector
+from skfem import Basis, ElementHexS2, ElementTetP2, ElementVector
 from skfem.models.elasticity import lame_parameters
 
 from tailbeam.physics.materials import Material
 
-ELEMENTS = {"tetra": ElementTetP2, "hexahedron": ElementHex2}
+ELEMENTS = {"tetra": ElementTetP2, "hexahedron": ElementHexS2}
 ELEMENT_NAMES = {
     "tetra": "quadratic tetrahedra (10 nodes, P2)",
-    "hexahedron": "triquadratic hexahedra (27 nodes, Q2)",
+    "hexahedron": "serendipity quadratic hexahedra (20 nodes)",
 }
 INTEGRATION_ORDER = 4  # exact for the Q2/P2 mass and stiffness on straight-sided cells
 

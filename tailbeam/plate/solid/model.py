@@ -9,10 +9,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from tailbeam.errors import InputError, require_nonnegative
-from tailbeam.physics.materials import CARBON_STEEL, Material
 from tailbeam.physics.contact_patch import disc_rule
-from tailbeam.plate.fe.sparse_solve import SymmetricSolver
+from tailbeam.physics.materials import CARBON_STEEL, Material
 from tailbeam.plate.solid.elasticity import assemble_elasticity
+from tailbeam.plate.solid.factor import factorize
 from tailbeam.plate.solid.impact_face import ImpactFace, impact_face
 from tailbeam.plate.solid.probe import displacement_operator
 from tailbeam.plate.solid.supports import (
@@ -45,7 +45,7 @@ class StructureModel:
     rigid_modes: int
     supports: tuple
     _surface: Surface | None = field(default=None, repr=False)
-    _solver: SymmetricSolver | None = field(default=None, repr=False)
+    _solver: object = field(default=None, repr=False)
 
     @property
     def plate(self):
@@ -91,11 +91,12 @@ class StructureModel:
         pts, weights = disc_rule(self.plate, centre, radius)
         return np.asarray(self.face_operator(pts).T @ weights).ravel()
 
-    def solver(self) -> SymmetricSolver:
+    def solver(self):
+        """Cached factorisation of the stiffness (``factor.factorize``)."""
         if self.rigid_modes:
             raise InputError(SUPPORTS_FIELD, "a free structure has no static compliance")
         if self._solver is None:
-            self._solver = SymmetricSolver(self.stiffness)
+            self._solver = factorize(self.stiffness)
         return self._solver
 
     def static_compliance(self, points, contact_radius: float = 0.0) -> np.ndarray:

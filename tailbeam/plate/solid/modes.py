@@ -18,6 +18,7 @@ from threadpoolctl import threadpool_limits
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.plate.basis import ModalBasis
 from tailbeam.plate.fe.sparse_solve import count_eigenvalues_below, lowest_modes
+from tailbeam.plate.solid.factor import factorize
 from tailbeam.plate.solid.model import StructureModel
 from tailbeam.progress import task
 
@@ -55,13 +56,14 @@ def solve_band(model: StructureModel, fmax_hz=None, count=None, on_solve=None):
     rigid = model.rigid_modes
     wanted = count
     if fmax_hz is not None:
-        below = count_eigenvalues_below(model.stiffness, model.mass, (2 * np.pi * fmax_hz) ** 2)
+        value = (2.0 * np.pi * fmax_hz) ** 2
+        below = count_eigenvalues_below(model.stiffness, model.mass, value, factorize)
         wanted = below - rigid if count is None else min(count, below - rigid)
         if wanted < 1:
             raise InputError("fmax_hz", f"no elastic mode lies below {fmax_hz!r} Hz")
     nev = min(wanted + rigid + MARGIN, model.n_dofs)
     lam, phi = lowest_modes(model.stiffness, model.mass, nev, shift=_shift(model, fmax_hz),
-                            on_solve=on_solve)  # fmt: skip
+                            on_solve=on_solve, factorize=factorize)  # fmt: skip
     lam, phi = lam[rigid:], phi[:, rigid:]
     freqs = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * np.pi)
     if fmax_hz is not None and np.count_nonzero(freqs <= fmax_hz) < wanted:

@@ -1,0 +1,140 @@
+"""Solid structures: the example tail beam's modes to 5 kHz (time, peak memory, mode count),
+and the element convergence study on the flat plate.
+
+    python benchmarks/bench_structure_modes.py --out DIR [--study] [--fmax 5000]
+
+Beam: meshes/tail_beam.msh (``--mesh``), pinned at ``hinge``, the jack a spring of
+``--jack`` N/m on ``jack``, every mode below ``--fmax`` (cold: assembly, Sylvester count,
+shift-invert Lanczos), peak resident memory of the process (getrusage).
+
+``--study``: the flat 0.6 x 0.6 x 0.01 m free steel plate as a volume mesh of serendipity
+hexahedra (one and two layers through the thickness), triquadratic hexahedra and quadratic
+tetrahedra over in-plane divisions, against the converged Reissner-Mindlin plate (Lagrange P4,
+32 divisions) and with the Mindlin-Kirchhoff difference beside it: the first 30 frequencies'
+largest relative difference. Needs gmsh only for the beam mesh when it is absent.
+
+Writes DIR/bench_structure_modes.csv (beam), DIR/element_study.csv and DIR/table.md.
+Single-threaded BLAS (OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1) for reproducible timings.
+"""
+
+import argparse
+import csv
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))  # the tests' tensor-grid mesh writer
+
+COUNT = 30
+
+
+def peak_gb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
+
+
+def beam(mesh: Path, fmax: float, jack: float) -> dict:
+    from tailbeam.plate.solid import Support, assemble_structure, structure_modes
+
+    t0 = time.perf_counter()
+    supports = [Support("pinned", group="hinge"), Support("spring", group="jack", stiffness=jack)]
+    model = assemble_structure(mesh, "top", supports)
+    t1 = time.perf_counter()
+    basis = structure_modes(model, fmax_hz=fmax)
+    t2 = time.perf_counter()
+    f = basis.frequencies_hz
+    return {"mesh": str(mesh), "dofs": model.n_dofs, "cells": basis.info["n_cells"],
+            "element": model.element, "fmax_hz": fmax, "modes": basis.n_modes,
+            "first_hz": f[0], "last_hz": f[-1], "assembly_s": t1 - t0,
+            "eigensolve_s": t2 - t1, "total_s": t2 - t0, "peak_gb": peak_gb(),
+            "first_10_hz": " ".join(f"{v:.1f}" for v in f[:10])}  # fmt: skip
+
+
+def element_study(rungs) -> list:
+    from skfem import ElementHex2, ElementHexS2
+    from solid_meshes import plate_mesh, tet_plate_mesh
+
+    import tailbeam.plate.solid.elasticity as elasticity
+    from tailbeam.physics.bodies import Plate
+    from tailbeam.plate import compute_modes
+    from tailbeam.plate.solid import assemble_structure, structure_modes
+
+    plate = Plate()
+    mindlin = compute_modes(plate, "FFFF", theory="mindlin", count=COUNT, divisions=32,
+                            use_cache=False).frequencies_hz  # fmt: skip
+    kirchhoff = compute_modes(plate, "FFFF", theory="kirchhoff", count=COUNT, divisions=32,
+                              use_cache=False).frequencies_hz  # fmt: skip
+    theories = np.abs(mindlin / kirchhoff - 1)
+    rows = []
+    cases = [("hexS2", ElementHexS2, 1), ("hexS2", ElementHexS2, 2), ("hex2", ElementHex2, 1),
+             ("tetP2", None, 1)]  # fmt: skip
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "plate.msh"
+        for name, element, layers in cases:
+            for n in rungs:
+                if element is None:
+                    tet_plate_mesh(path, divisions=n, layers=layers)
+                else:
+                    elasticity.ELEMENTS["hexahedron"] = element
+                    plate_mesh(path, divisions=n, layers=layers)
+                t0 = time.perf_counter()
+                model = assemble_structure(path, "top", [], free=True)
+                f = structure_modes(model, count=COUNT).frequencies_hz
+                err = np.abs(f / mindlin - 1)
+                rows.append({"element": name, "layers": layers, "divisions": n,
+                             "dofs": model.n_dofs, "max_rel_diff_vs_mindlin": err.max(),
+                             "mode_of_max": int(np.argmax(err)) + 1,
+                             "within_theories_all_30": bool(np.all(err <= theories)),
+                             "max_mindlin_vs_kirchhoff": theories.max(),
+                             "time_s": time.perf_counter() - t0})  # fmt: skip
+                print(rows[-1], flush=True)
+    elasticity.ELEMENTS["hexahedron"] = ElementHexS2
+    return rows
+
+
+def write_csv(path: Path, rows: list) -> None:
+    with open(path, "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def table(rows: list) -> str:
+    keys = list(rows[0])
+    out = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    for r in rows:
+        out.append("| " + " | ".join(f"{v:.4g}" if isinstance(v, float) else str(v)
+                                     for v in r.values()) + " |")  # fmt: skip
+    return "\n".join(out)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--mesh", type=Path, default=ROOT / "meshes" / "tail_beam.msh")
+    parser.add_argument("--fmax", type=float, default=5000.0)
+    parser.add_argument("--jack", type=float, default=2.0e8, help="jack stiffness, N/m")
+    parser.add_argument("--study", action="store_true", help="also the element study")
+    parser.add_argument("--skip-beam", action="store_true")
+    parser.add_argument("--rungs", type=int, nargs="+", default=[12, 16, 24, 32])
+    args = parser.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    parts = []
+    if not args.skip_beam:
+        row = beam(args.mesh, args.fmax, args.jack)
+        print(row, flush=True)
+        write_csv(args.out / "bench_structure_modes.csv", [row])
+        parts.append("## Tail beam modes\n\n" + table([row]))
+    if args.study:
+        rows = element_study(args.rungs)
+        write_csv(args.out / "element_study.csv", rows)
+        parts.append("## Element study (free flat plate, first 30 modes)\n\n" + table(rows))
+    (args.out / "table.md").write_text("\n\n".join(parts) + "\n")
+
+
+if __name__ == "__main__":
+    main()
