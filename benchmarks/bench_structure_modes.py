@@ -7,18 +7,24 @@ Beam: meshes/tail_beam.msh (``--mesh``), pinned at ``hinge``, the jack a spring 
 ``--jack`` N/m on ``jack``, every mode below ``--fmax`` (cold: assembly, Sylvester count,
 shift-invert Lanczos), peak resident memory of the process (getrusage).
 
+``--refine SIZE``: the example beam against the same beam meshed at SIZE m (meshes/tail_beam.py,
+gmsh), every mode below ``--refine-fmax`` (2 kHz): the rib-stiffened box against a finer
+solution.
+
 ``--study``: the flat 0.6 x 0.6 x 0.01 m free steel plate as a volume mesh of serendipity
 hexahedra (one and two layers through the thickness), triquadratic hexahedra and quadratic
 tetrahedra over in-plane divisions, against the converged Reissner-Mindlin plate (Lagrange P4,
 32 divisions) and with the Mindlin-Kirchhoff difference beside it: the first 30 frequencies'
 largest relative difference. Needs gmsh only for the beam mesh when it is absent.
 
-Writes DIR/bench_structure_modes.csv (beam), DIR/element_study.csv and DIR/table.md.
+Writes DIR/bench_structure_modes.csv (beam), DIR/element_study.csv, DIR/refinement.csv and
+DIR/table.md.
 Single-threaded BLAS (OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1) for reproducible timings.
 """
 
 import argparse
 import csv
+import os
 import resource
 import sys
 import tempfile
@@ -37,10 +43,17 @@ def peak_gb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
 
 
+def cpu_s() -> float:
+    """CPU time of this process (user + system), s: less sensitive than wall time to the
+    other jobs of a shared machine."""
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
 def beam(mesh: Path, fmax: float, jack: float) -> dict:
     from tailbeam.plate.solid import Support, assemble_structure, structure_modes
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), cpu_s()
     supports = [Support("pinned", group="hinge"), Support("spring", group="jack", stiffness=jack)]
     model = assemble_structure(mesh, "top", supports)
     t1 = time.perf_counter()
@@ -50,8 +63,39 @@ def beam(mesh: Path, fmax: float, jack: float) -> dict:
     return {"mesh": str(mesh), "dofs": model.n_dofs, "cells": basis.info["n_cells"],
             "element": model.element, "fmax_hz": fmax, "modes": basis.n_modes,
             "first_hz": f[0], "last_hz": f[-1], "assembly_s": t1 - t0,
-            "eigensolve_s": t2 - t1, "total_s": t2 - t0, "peak_gb": peak_gb(),
+            "eigensolve_s": t2 - t1, "total_s": t2 - t0, "cpu_s": cpu_s() - c0,
+            "load_average_1min": os.getloadavg()[0], "peak_gb": peak_gb(),
             "first_10_hz": " ".join(f"{v:.1f}" for v in f[:10])}  # fmt: skip
+
+
+def refinement(mesh: Path, fine_size: float, fmax: float, jack: float) -> list:
+    """The example beam against the same beam meshed finer (meshes/tail_beam.py --size;
+    needs gmsh): every mode below ``fmax`` of both, relative differences (the fine mesh as
+    the converged reference)."""
+    import importlib.util
+
+    from tailbeam.plate.solid import Support, assemble_structure, structure_modes
+
+    spec = importlib.util.spec_from_file_location("tail_beam", ROOT / "meshes" / "tail_beam.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    supports = [Support("pinned", group="hinge"), Support("spring", group="jack", stiffness=jack)]
+    rows, freqs = [], {}
+    with tempfile.TemporaryDirectory() as tmp:
+        fine = Path(tmp) / "fine.msh"
+        script.main(["--size", str(fine_size), "--out", str(fine)])
+        for name, path in (("example", mesh), ("fine", fine)):
+            model = assemble_structure(path, "top", supports)
+            freqs[name] = structure_modes(model, fmax_hz=fmax).frequencies_hz
+            rows.append({"mesh": name, "dofs": model.n_dofs, "modes_below_hz": fmax,
+                         "modes": len(freqs[name])})  # fmt: skip
+    n = min(len(freqs["example"]), len(freqs["fine"]))
+    diff = freqs["example"][:n] / freqs["fine"][:n] - 1
+    for row in rows:
+        row["max_rel_diff"] = float(np.abs(diff).max())
+        row["rel_diff_first_10"] = " ".join(f"{100 * d:.2f}%" for d in diff[:10])
+        row["rel_diff_last"] = float(diff[-1])
+    return rows
 
 
 def element_study(rungs) -> list:
@@ -121,6 +165,13 @@ def main(argv=None):
     parser.add_argument("--study", action="store_true", help="also the element study")
     parser.add_argument("--skip-beam", action="store_true")
     parser.add_argument("--rungs", type=int, nargs="+", default=[12, 16, 24, 32])
+    parser.add_argument(
+        "--refine",
+        type=float,
+        metavar="SIZE",
+        help="also compare with the beam meshed at SIZE m (gmsh)",
+    )
+    parser.add_argument("--refine-fmax", type=float, default=2000.0)
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     parts = []
@@ -133,6 +184,11 @@ def main(argv=None):
         rows = element_study(args.rungs)
         write_csv(args.out / "element_study.csv", rows)
         parts.append("## Element study (free flat plate, first 30 modes)\n\n" + table(rows))
+    if args.refine:
+        rows = refinement(args.mesh, args.refine, args.refine_fmax, args.jack)
+        print(rows, flush=True)
+        write_csv(args.out / "refinement.csv", rows)
+        parts.append("## Example beam against a finer mesh\n\n" + table(rows))
     (args.out / "table.md").write_text("\n\n".join(parts) + "\n")
 
 

@@ -7,7 +7,7 @@ be one: its bounding rectangle centred on the origin and covered by it. The ``Pl
 stands for has the face's sides and the thickness of material straight below its centre.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from skfem import MeshTri
@@ -15,6 +15,7 @@ from skfem import MeshTri
 from tailbeam.errors import InputError
 from tailbeam.physics.bodies import Plate
 from tailbeam.physics.materials import Material
+from tailbeam.plate.solid.surface import cyclic_corners, surface_of
 
 FIELD = "plate.impact_face"
 
@@ -29,14 +30,16 @@ class ImpactFace:
     facets: np.ndarray
     _triangles: MeshTri
     _triangle_cell: np.ndarray
+    _finder: dict = field(default_factory=dict, repr=False)  # built on first use, kept
 
     def cells_at(self, points) -> np.ndarray:
         """(p,) the cell under each point (p, 2) m of the face (on the face's rectangle)."""
         pts = np.atleast_2d(np.asarray(points, dtype=float))
         half = 0.5 * np.array([self.plate.size_x, self.plate.size_y]) * (1.0 - 1e-12)
         pts = np.clip(pts, -half, half)  # points exactly on the rim stay inside
-        finder = self._triangles.element_finder()
-        return self._triangle_cell[finder(pts[:, 0], pts[:, 1])]
+        if "finder" not in self._finder:
+            self._finder["finder"] = self._triangles.element_finder()
+        return self._triangle_cell[self._finder["finder"](pts[:, 0], pts[:, 1])]
 
 
 def impact_face(vmesh, name: str, material: Material) -> ImpactFace:
@@ -70,8 +73,6 @@ def impact_face(vmesh, name: str, material: Material) -> ImpactFace:
 def _face_triangles(mesh, facets, owners):
     """The face as a planar triangle mesh (quadrilaterals split) with each triangle's cell,
     and the face's area (m^2)."""
-    from tailbeam.plate.solid.surface import cyclic_corners
-
     corners = mesh.facets[:, facets]
     if corners.shape[0] == 3:
         tri, cell = corners, owners
@@ -81,7 +82,7 @@ def _face_triangles(mesh, facets, owners):
         cell = np.concatenate([owners, owners])
     used, tri = np.unique(tri, return_inverse=True)
     tri = tri.reshape(3, -1)
-    xy = mesh.p[:2, used]
+    xy = np.ascontiguousarray(mesh.p[:2, used])
     a, b, c = (xy[:, tri[k]] for k in range(3))
     area = 0.5 * np.abs((b - a)[0] * (c - a)[1] - (b - a)[1] * (c - a)[0])
     return MeshTri(xy, tri, validate=False), cell, float(area.sum())
@@ -106,8 +107,6 @@ def _plate(name, xy, area, material, vmesh) -> Plate:
 def _depth_below(mesh, xy) -> float:
     """Thickness of material straight below the point (x, y, 0): where a vertical line
     through it first leaves the solid (the highest boundary face below z = 0)."""
-    from tailbeam.plate.solid.surface import surface_of
-
     tri = surface_of(mesh).triangles  # (t, 3, 3)
     a, b, c = tri[:, 0, :2], tri[:, 1, :2], tri[:, 2, :2]
     det = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]

@@ -11,10 +11,11 @@ import scipy.sparse as sp
 from tailbeam.errors import InputError, require_nonnegative
 from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.physics.materials import CARBON_STEEL, Material
+from tailbeam.plate.fe.model import check_points
 from tailbeam.plate.solid.elasticity import assemble_elasticity
 from tailbeam.plate.solid.factor import factorize
 from tailbeam.plate.solid.impact_face import ImpactFace, impact_face
-from tailbeam.plate.solid.probe import displacement_operator
+from tailbeam.plate.solid.probe import DisplacementProbe
 from tailbeam.plate.solid.supports import (
     Support,
     apply_supports,
@@ -45,6 +46,7 @@ class StructureModel:
     rigid_modes: int
     supports: tuple
     _surface: Surface | None = field(default=None, repr=False)
+    _probe: DisplacementProbe | None = field(default=None, repr=False)
     _solver: object = field(default=None, repr=False)
 
     @property
@@ -55,13 +57,18 @@ class StructureModel:
     def n_dofs(self) -> int:
         return int(self.stiffness.shape[0])
 
+    def probe(self) -> DisplacementProbe:
+        if self._probe is None:
+            self._probe = DisplacementProbe(self.basis)
+        return self._probe
+
     def face_operator(self, points) -> sp.csr_matrix:
         """(p, n) z-displacement (m) at impact-face points (p, 2) from reduced vectors."""
         pts = _face_points(self.plate, points)
         cells = self.face.cells_at(pts)
         xyz = np.column_stack([pts, np.zeros(len(pts))])
         dirs = np.tile([0.0, 0.0, 1.0], (len(pts), 1))
-        return (displacement_operator(self.basis, xyz, cells, dirs) @ self.transform).tocsr()
+        return (self.probe().operator(xyz, cells, dirs) @ self.transform).tocsr()
 
     def surface(self) -> Surface:
         if self._surface is None:
@@ -81,7 +88,7 @@ class StructureModel:
             if dirs.shape != xyz.shape or np.any(norm == 0):
                 raise InputError(field_name, "directions must be nonzero (x, y, z) vectors")
             dirs = dirs / norm
-        return (displacement_operator(self.basis, xyz, cells, dirs) @ self.transform).tocsr()
+        return (self.probe().operator(xyz, cells, dirs) @ self.transform).tocsr()
 
     def load_vector(self, point, contact_radius: float = 0.0) -> np.ndarray:
         """(n,) generalised load of 1 N along +z spread uniformly over a disc of
@@ -116,8 +123,6 @@ class StructureModel:
 
 def _face_points(plate, points) -> np.ndarray:
     """(p, 2) points of the impact face's rectangle, else InputError."""
-    from tailbeam.plate.fe.model import check_points
-
     return check_points(plate, points)
 
 
