@@ -81,3 +81,29 @@ def test_unreadable_or_flat_mesh(tmp_path):
 
     said = _refused("plate.mesh", read_volume_mesh, MESH_DIR / "plate_0.6x0.6_6x6.msh")
     assert "volume mesh" in said
+
+
+def test_region_support_is_the_group_it_covers(small_plate):
+    """A box region around the side faces selects the same facets as the 'sides' group:
+    the same model, frequencies equal to round-off."""
+    by_group = assemble_structure(small_plate, "top", [Support("clamped", group="sides")])
+    # one thin box around each side face (1 mm deep into the plate: no top or bottom face
+    # lies wholly inside it)
+    z = [-0.011, 0.001]
+    boxes = ([[-0.31, -0.299], [-0.31, 0.31], z], [[0.299, 0.31], [-0.31, 0.31], z],
+             [[-0.31, 0.31], [-0.31, -0.299], z], [[-0.31, 0.31], [0.299, 0.31], z])  # fmt: skip
+    sides = [Support("clamped", region=box) for box in boxes]
+    by_region = assemble_structure(small_plate, "top", sides)
+    assert by_region.n_dofs == by_group.n_dofs
+    f_group = structure_modes(by_group, count=4).frequencies_hz
+    f_region = structure_modes(by_region, count=4).frequencies_hz
+    assert np.allclose(f_region, f_group, rtol=1e-12, atol=0)
+
+
+def test_tetrahedral_mesh_groups_are_read(tmp_path):
+    from solid_meshes import tet_plate_mesh
+
+    vmesh = read_volume_mesh(tet_plate_mesh(tmp_path / "tet.msh", divisions=3))
+    assert vmesh.kind == "tetra"
+    # 3 x 3 grid cells, each face cut in two triangles
+    assert len(vmesh.faces["top"]) == 18 and len(vmesh.faces["sides"]) == 24
