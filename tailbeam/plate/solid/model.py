@@ -1,6 +1,6 @@
-"""The assembled structure: a volume mesh, its elasticity, supports and impact face, as the
-reduced matrices K q'' ... of its held DOFs (u = T q), the operators that read displacements
-at the impact face and anywhere on the surface, and static solves.
+"""The assembled structure: a volume mesh with its elasticity, supports and impact face;
+its stiffness and mass on the held DOFs q (full displacements u = T q), the operators that
+read displacements on the impact face and anywhere on the surface, and static solves.
 """
 
 from dataclasses import dataclass, field
