@@ -11,7 +11,10 @@ each following one protocol (``tailbeam.solvers.base.Solver``):
 - ``"stream"``: the fast stream solver, on the rigid or the modal plate; it runs every scene;
 - ``"stream-reference"``: the slow independent reference of the stream solver (scipy DOP853,
   every pair watched, at most ``REFERENCE_MAX_PARTICLES`` bodies), on the rigid plate;
-- ``"auto"`` (the default): ``"single-ball"`` where it can run, else ``"stream"``.
+- ``"auto"`` (the default): ``"single-ball"`` where it can run, else ``"stream"``; a scene
+  with friction (``[contact.friction]``): ``"stream-reference"``, the one solver that models
+  it, if it can run the scene (rigid plate, at most ``REFERENCE_MAX_PARTICLES`` bodies), else
+  refused.
 
 Running one scene through two solvers is how a user checks one against the other.
 """
@@ -76,12 +79,30 @@ def choose_solver(scene, solver: str = "auto", field: str = "solver") -> Solver:
     that does not exist or cannot run the scene."""
     if solver not in CHOICES:
         raise InputError(field, f"must be one of {', '.join(CHOICES)}; got {solver!r}")
+    if solver == "auto" and scene.friction is not None:
+        return _friction_solver(scene, field)
     if solver == "auto":
         solver = "stream" if scene.needs_stream_solver else "single-ball"
     method = SOLVERS[solver]
     why = method.refusal(scene)
     if why:
         raise InputError(field, why)
+    return method
+
+
+def _friction_solver(scene, field: str) -> Solver:
+    """The solver "auto" picks for a scene with friction: the stream reference, or an
+    InputError naming ``contact.friction`` when it cannot run the scene."""
+    method = SOLVERS["stream-reference"]
+    why = method.refusal(scene)
+    n = len(scene.particles)
+    if why is None and n > method.max_particles:
+        why = f"{n} particles, above its limit of {method.max_particles}"
+    if why:
+        raise InputError(
+            "contact.friction", "only the stream reference models friction and it cannot run "
+            f"this scene ({why}); remove [contact.friction] to run it frictionless"
+        )  # fmt: skip
     return method
 
 

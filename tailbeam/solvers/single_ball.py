@@ -20,6 +20,11 @@ class SingleBall(Solver):
     stream = False
 
     def refusal(self, scene) -> str | None:
+        if scene.friction is not None:
+            return (
+                "contact.friction: 'single-ball' models frictionless contacts only; friction "
+                "and rotation run on --solver stream-reference"
+            )
         if not scene.needs_stream_solver:
             return None
         return (

@@ -96,7 +96,8 @@ class StreamSettings:
 
 @dataclass(frozen=True)
 class Particle:
-    """A released particle: position (m) and velocity (m/s) at its release time t_release."""
+    """A released particle: position (m), velocity (m/s) and angular velocity (rad/s) at its
+    release time t_release."""
 
     name: str
     stream: str
@@ -107,16 +108,18 @@ class Particle:
     t_release: float
     position: tuple
     velocity: tuple
+    angular_velocity: tuple = (0.0, 0.0, 0.0)
 
     def ball(self) -> Ball:
         """The particle as a ``tailbeam.Ball`` at its release state."""
-        return Ball(self.name, self.material, self.radius, self.position, self.velocity)
+        return Ball(self.name, self.material, self.radius, self.position, self.velocity,
+                    self.angular_velocity)  # fmt: skip
 
     @classmethod
     def from_ball(cls, ball: Ball, label: str) -> "Particle":
         """A ``[[balls]]`` entry as a particle: no stream, released at 0 s, labelled ``label``."""
         return cls(ball.name, "", label, ball.material, ball.radius, ball.mass, 0.0,
-                   ball.position, ball.velocity)  # fmt: skip
+                   ball.position, ball.velocity, ball.angular_velocity)  # fmt: skip
 
 
 def default_label(ball: Ball) -> str:

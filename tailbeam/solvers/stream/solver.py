@@ -37,6 +37,10 @@ REFERENCE_RTOL = 1e-10
 # (examples/small_stream.toml: 1082 steps); it grows ~N^2 (all pairs).
 REFERENCE_STEP_SECONDS = 3e-3
 REFERENCE_STEP_PARTICLES = 12
+FRICTION_REFUSAL = (
+    "contact.friction: '{name}' models frictionless contacts only; friction and rotation run "
+    f"on --solver stream-reference (rigid plate, at most {REFERENCE_MAX_PARTICLES} particles)"
+)
 
 
 class Stream(Solver):
@@ -48,6 +52,11 @@ class Stream(Solver):
     label = "fast stream solver"
     max_particles = MAX_PARTICLES
     rtol, max_steps = DEFAULT_RTOL, DEFAULT_MAX_STEPS
+
+    def refusal(self, scene) -> str | None:
+        if scene.friction is None:
+            return None
+        return FRICTION_REFUSAL.format(name=self.name)
 
     def estimate(self, n_particles: int, max_steps: int) -> tuple[float, float]:
         """Upper-bound-style estimates (bytes, s): per particle ~30 contact records and force
@@ -124,7 +133,7 @@ class StreamReference(Stream):
             return simulate_reference(
                 scene.particles, scene.incline, scene.duration, laws=scene.contacts(),
                 rtol=rtol, max_steps=max_steps, progress=advance,
-                info={"solver_choice": self.name},
+                info={"solver_choice": self.name}, friction=scene.friction,
             )  # fmt: skip
 
 
@@ -189,14 +198,16 @@ def _delivered(streams, particles, run, duration) -> dict:
 
 def simulate_reference(
     particles, incline, duration, *, laws, rtol=REFERENCE_RTOL, max_steps=REFERENCE_MAX_STEPS,
-    progress=None, info=None,
+    progress=None, info=None, friction=None,
 ) -> Result:  # fmt: skip
     """The slow reference (``simulate_stream_reference``) on ``particles``, as a Result;
-    arguments as ``simulate_stream``'s (``info``: more entries for ``Result.info``)."""
+    arguments as ``simulate_stream``'s (``info``: more entries for ``Result.info``;
+    ``friction``: a ``FrictionModel`` or None)."""
     ref = simulate_stream_reference(
         [p.ball() for p in particles], incline, duration,
         contacts=contact_table(particles, laws, incline.plate.material), rtol=rtol,
         max_steps=max_steps, release_times=[p.t_release for p in particles], progress=progress,
+        friction=friction,
     )  # fmt: skip
     stats = {"n_steps": ref.steps, "n_contacts": len(ref.contacts), "n_leaves": len(ref.leaves)}
     number_contacts(ref.contacts, ref.leaves, incline)
@@ -205,6 +216,7 @@ def simulate_reference(
         impacts=sorted(ref.contacts, key=lambda r: (r.t_start, r.ball)), events=ref.events,
         leaves=ref.leaves, message="reached the end of the simulation", stats=stats,
         info={**ref.info, **(info or {})},
+        angular_velocity={} if friction is None else ref.angular_velocity,
     )  # fmt: skip
 
 
