@@ -49,7 +49,9 @@ class SceneChanges:
     def slip(self, pair, y) -> float:
         """The slip speed (m/s) of ``pair`` at state vector y (nan without friction)."""
         x, v = self.layout.split(y)
-        return slip_speed(pair, self.kinematics, self.radius, x, v, self.layout.spins(y))
+        modes = self.layout.modes(y)
+        modes = None if modes is None else tuple(a[None] for a in modes)
+        return slip_speed(pair, self.kinematics, self.radius, x, v, self.layout.spins(y), modes)
 
     def next_stop(self, duration):
         """Where the integration must stop next (s): the next release time or ``duration``."""

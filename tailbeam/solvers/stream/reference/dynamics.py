@@ -109,21 +109,40 @@ class Dynamics:
             with np.errstate(over="ignore", invalid="ignore"):
                 return modal_rhs(t, y)
 
+        spin = layout.spin
+        if spin:
+            inertia = 0.4 * m * self.radius[layout.active] ** 2
+            table = FrictionTable.of(pairs, self.radius) if pairs else None
+            half = 0.5 * plate.basis.plate.thickness
+
         def modal_rhs(t, y):
             x, v = layout.split(y)
             q, qd = layout.modes(y)
+            w = layout.spins(y)
+            alpha = None if w is None else np.zeros_like(w)
             acc = np.tile(g, (len(m), 1))
             modal_force = np.zeros(plate.n_modes)
             if pairs:
-                kin, li, lj, is_plate, slope, phi = kinematics.modal(ix, x, v, (q, qd))
+                kin, li, lj, is_plate, slope, phi, grad = kinematics.modal(ix, x, v, (q, qd))
                 f = impact_force_in_region(kin.penetration, kin.rate, laws, ramp, clamped)
                 fn = f[:, None] * kin.normal
                 fn[:, :2] -= f[:, None] * slope  # zero slope for ball-ball pairs
+                modal_force = -(f @ phi)
+                if spin:
+                    surface = kinematics.surface_velocity(grad, qd, len(is_plate))
+                    fr = friction_of(table, ix, kin, x[None], v[None], w[None], f, surface)
+                    fn = fn + fr.force
+                    np.add.at(alpha, li, fr.torque_i / inertia[li, None])
+                    np.add.at(
+                        alpha, lj[~is_plate], fr.torque_j[~is_plate] / inertia[lj[~is_plate], None]
+                    )
+                    modal_force += half * np.einsum("pk,pmk->m", fr.force[:, :2], grad)
                 np.add.at(acc, li, fn / m[li, None])
                 ball = ~is_plate
                 np.add.at(acc, lj[ball], -fn[ball] / m[lj[ball], None])
-                modal_force = -(f @ phi)
             qdd = plate.acceleration(q, qd, modal_force)
+            if spin:
+                return np.concatenate([v.ravel(), acc.ravel(), alpha.ravel(), qd, qdd])
             return np.concatenate([v.ravel(), acc.ravel(), qd, qdd])
 
         return rhs

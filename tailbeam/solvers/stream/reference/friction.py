@@ -98,10 +98,11 @@ def tile(table: FrictionTable, k: int) -> FrictionTable:
     return FrictionTable(*(np.tile(getattr(table, f), k) for f in table.__dataclass_fields__))
 
 
-def friction_of(table, ix, kin, x, v, w, force) -> PairFriction:
+def friction_of(table, ix, kin, x, v, w, force, surface=None) -> PairFriction:
     """``PairFriction`` of the pairs of ``table`` (a ``FrictionTable``) and ``ix`` (their
     ``PairIndex``) with kinematics ``kin`` at states x, v, w (K, n, 3) and normal forces
-    ``force`` (K x P flattened, N), on the rigid plate."""
+    ``force`` (K x P flattened, N); ``surface``: the plate surface's velocity under each
+    pair (K x P, 3; m/s) on the modal plate, None on the rigid plate."""
     k, p = x.shape[0], len(ix.li)
     if k == 1:
         rows, li, lj, plate = 0, ix.li, ix.lj, ix.is_plate
@@ -112,16 +113,27 @@ def friction_of(table, ix, kin, x, v, w, force) -> PairFriction:
     xj, vj, wj = x[rows, lj], v[rows, lj], w[rows, lj]
     xj[plate] = xi[plate] * np.array([1.0, 1.0, 0.0])
     vj[plate], wj[plate] = 0.0, 0.0
+    if surface is not None:
+        vj[plate] = surface[plate]
     return pair_friction(tile(table, k) if k > 1 else table, kin, force, xi, vi, wi, xj, vj, wj)
 
 
-def slip_speed(pair, kinematics, radius, x, v, w) -> float:
+def slip_speed(pair, kinematics, radius, x, v, w, modes=None) -> float:
     """The slip speed (m/s) of ``pair`` at positions x, velocities v and angular velocities
-    w (n, 3) of the present balls; nan without friction (w None)."""
+    w (n, 3) of the present balls (and the modal plate's (q, q')); nan without friction."""
     if w is None or pair.friction is None:
         return float("nan")
     ix = kinematics.index([pair])
-    kin, _, _, _ = kinematics.of(ix, x, v)
+    kin, _, _, _, surface = kinematics_with_surface(kinematics, ix, x[None], v[None], modes)
     table = FrictionTable.of([pair], radius)
-    fr = friction_of(table, ix, kin, x[None], v[None], w[None], np.zeros(1))
+    fr = friction_of(table, ix, kin, x[None], v[None], w[None], np.zeros(1), surface)
     return float(np.linalg.norm(fr.slip[0]))
+
+
+def kinematics_with_surface(kinematics, ix, x, v, modes):
+    """The kinematics of pairs ``ix`` at states x, v (K, n, 3) and, on the modal plate, the
+    plate surface's velocity under them (K x P, 3; None on the rigid plate)."""
+    if modes is None:
+        return (*kinematics.of(ix, x, v), None)
+    kin, li, lj, is_plate, _, _, grad = kinematics.modal(ix, x, v, modes)
+    return kin, li, lj, is_plate, kinematics.surface_velocity(grad, modes[1], len(ix.li))

@@ -210,10 +210,10 @@ def simulate_stream_reference(
             raise InputError("plate", "must be a ReferencePlate (a modal basis and its damping)")
         plate.check_size(incline)
         _check_modal_work(plate, duration, max_steps)
-        if friction is not None:
+        if friction is not None and plate.frozen:
             raise InputError(
-                "contact.friction", "the stream reference's modal plate is frictionless; "
-                "friction runs on the rigid plate"
+                "contact.friction", "friction on the stream reference's modal plate needs "
+                'exact mode shapes (ReferencePlate(..., shapes="exact"))'
             )  # fmt: skip
     if friction is not None and not isinstance(friction, FrictionModel):
         raise InputError("contact.friction", "must be a FrictionModel (or None: frictionless)")

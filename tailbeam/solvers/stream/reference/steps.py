@@ -17,7 +17,11 @@ from tailbeam.solvers.numerics.step_events import (
     chebyshev_coefficients,
     interpolant_max,
 )
-from tailbeam.solvers.stream.reference.friction import FrictionTable, friction_of
+from tailbeam.solvers.stream.reference.friction import (
+    FrictionTable,
+    friction_of,
+    kinematics_with_surface,
+)
 from tailbeam.solvers.stream.reference.pairs import law_table
 
 
@@ -104,10 +108,11 @@ class StepSeries:
         """Add the step's tangential impulses (on each pair's ball i) and the energy friction
         dissipated on it: ``force`` (P, K) normal forces (N) at the step's points, ``states``
         and ``w`` the states there, h the step (s)."""
-        x, v, _ = states
+        x, v, modes = states
         ix = self.kinematics.index(pairs)
-        kin, _, _, _ = self.kinematics.of(ix, x, v)
-        fr = friction_of(FrictionTable.of(pairs, self.radius), ix, kin, x, v, w, force.T.ravel())
+        kin, _, _, _, surface = kinematics_with_surface(self.kinematics, ix, x, v, modes)
+        table = FrictionTable.of(pairs, self.radius)
+        fr = friction_of(table, ix, kin, x, v, w, force.T.ravel(), surface)
         k = len(STEP_POINTS)
         tangential = fr.force.reshape(k, len(pairs), 3)
         impulse = np.einsum("k,kpc->pc", STEP_WEIGHTS, tangential) * h
