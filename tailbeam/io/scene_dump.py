@@ -116,6 +116,8 @@ def stream_to_dict(s) -> dict:
     d["height"] = s.height[0] if s.height[0] == s.height[1] else list(s.height)
     d.update(velocity=list(s.velocity), velocity_spread=s.velocity_spread, seed=s.seed)
     d["max_tries"] = s.max_tries
+    if s.angular_velocity_spread > 0.0:  # written only when set
+        d["angular_velocity_spread"] = s.angular_velocity_spread
     return d
 
 
