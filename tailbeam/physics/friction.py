@@ -1,7 +1,8 @@
 """Friction and rolling resistance of a contact: the Adams CONTACT friction law, written once.
 
 The friction coefficient is a function of the slip speed v = |v_slip| (m/s) at the contact
-point, built from Adams' cubic STEP (``step``):
+point, built from Adams' cubic STEP (``tailbeam.physics.contact_law.step``, the one the
+IMPACT law uses):
 
     mu(v) = STEP(v, 0, 0, v_s, mu_s)            0 <= v < v_s   (stiction transition)
     mu(v) = STEP(v, v_s, mu_s, v_d, mu_d)       v_s <= v < v_d (friction transition)
@@ -27,18 +28,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from tailbeam.errors import InputError, require_nonnegative, require_positive
+from tailbeam.physics.contact_law import step  # Adams' STEP, the IMPACT law's own
 
 # Adams CONTACT defaults (100 mm/s and 1000 mm/s): coarse; the manual says how far to trust them
 DEFAULT_STICTION_VELOCITY = 0.1  # m/s
 DEFAULT_TRANSITION_VELOCITY = 1.0  # m/s
 KEYS = ("static", "dynamic", "stiction_velocity", "transition_velocity", "rolling")
-
-
-def step(x, x0, h0, x1, h1):
-    """Adams' STEP: h0 for x <= x0, h1 for x >= x1, and the cubic
-    h0 + (h1 - h0) s^2 (3 - 2 s), s = (x - x0) / (x1 - x0), between (arrays broadcast)."""
-    s = np.clip((np.asarray(x, dtype=float) - x0) / (x1 - x0), 0.0, 1.0)
-    return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
 
 
 @dataclass(frozen=True)
