@@ -205,3 +205,17 @@ def test_on_the_modal_plate_friction_drives_the_modes_and_the_ledger_closes():
     assert res.dissipated[-1] > 1e-4 * ledger[0]
     q, qd = res.plate_states[-1]
     assert 0.5 * np.sum(qd**2 + (basis.omega * q) ** 2) > 1e-4 * ledger[0]
+
+
+def test_without_friction_the_normal_impulse_is_the_momentum_change():
+    """Frictionless (no friction model): the step quadrature of the normal force equals the
+    ball's momentum balance m (v_in + v_out) + m g (t_end - t_start) on the horizontal plate
+    to the integration's tolerance; no tangential impulse, spins untouched."""
+    ball = Ball("a", COAL, R, (0.0, 0.0, R + 5e-3), (0.3, 0.0, -1.0), (1.0, 2.0, 3.0))
+    res = simulate_stream_reference([ball], InclinedPlate(), 0.02, rtol=1e-11, damping=300.0)
+    rec = res.contacts[0]
+    m = ball.mass
+    balance = m * (rec.v_in + rec.v_out) + m * G * (rec.t_end - rec.t_start)
+    assert rec.normal_impulse == pytest.approx(balance, rel=1e-9)
+    assert (rec.tangential_impulse, rec.tangential_end) == (0.0, "frictionless")
+    assert list(res.angular_velocity["a"]) == [1.0, 2.0, 3.0] and res.spins == []

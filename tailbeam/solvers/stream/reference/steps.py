@@ -75,24 +75,20 @@ class StepSeries:
         self.spins, self.dissipated, self.friction_work = [], [], 0.0
 
     def update_peaks(self, dense, t0, t1) -> None:
-        """Update the peak force and largest penetration of the contacts on the accepted step
-        [t0, t1] (s) with dense output ``dense``."""
+        """Update the peak force, largest penetration and impulses of the contacts (and with
+        friction the dissipated energy) on the accepted step [t0, t1] (s) with dense output
+        ``dense``."""
         pairs = self.pairs.in_contact()
         if not pairs or t1 <= t0:
             return
-        states = self.layout.states_at(dense, t0 + STEP_POINTS * (t1 - t0))
+        times = t0 + STEP_POINTS * (t1 - t0)
+        states = self.layout.states_at(dense, times)
         force, delta = self.pair_forces(pairs, *states)
         impulse = force @ STEP_WEIGHTS * (t1 - t0)
         for q, p in enumerate(pairs):
             p.normal_impulse += float(impulse[q])
         if self.layout.spin:
-            self.friction_step(
-                pairs,
-                states,
-                force,
-                self.layout.spins_at(dense, t0 + STEP_POINTS * (t1 - t0)),
-                t1 - t0,
-            )
+            self.friction_step(pairs, states, force, self.layout.spins_at(dense, times), t1 - t0)
         # Refined only where the node maximum comes within 1 % of the record so far: between
         # nodes the interpolant cannot exceed them by more (a step resolved to rtol 1e-12
         # spans ~(1e-12)^(1/8) of the force's time scale; the overshoot is ~1e-6).
