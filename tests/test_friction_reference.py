@@ -147,8 +147,8 @@ def test_an_oblique_impact_in_gross_slip_has_tangential_impulse_mu_times_normal(
 
 def test_a_glancing_ball_ball_collision_conserves_momentum_and_angular_momentum():
     """Two spinning balls, no gravity, far above the plate, glancing with friction (c = 0):
-    linear momentum to round-off, angular momentum about the origin to the integration's
-    tolerance (x x v is quadratic in the state), energy + dissipated constant."""
+    linear momentum and angular momentum about the origin to round-off (measured 3.5e-16 and
+    4.3e-16 of the summed magnitudes), energy + dissipated constant (measured 9.5e-13)."""
     a = Ball("a", COAL, R, (-0.02, 0.0, 0.2), (2.0, 0.0, 0.0), (0.0, 0.0, 30.0))
     b = Ball("b", get_material("sandstone"), 0.02, (0.03, 0.02, 0.2), (-1.0, 0.2, 0.1),
              (10.0, -5.0, 0.0))  # fmt: skip
@@ -175,10 +175,10 @@ def test_a_glancing_ball_ball_collision_conserves_momentum_and_angular_momentum(
             ]
         )
     )
-    assert np.max(np.abs(h - h[0])) <= 1e-9 * scale_h
+    assert np.max(np.abs(h - h[0])) <= 1e-13 * scale_h
     ledger = res.energy + res.dissipated
-    assert np.max(np.abs(ledger - ledger[0])) <= 1e-9 * ledger[0]
-    assert res.dissipated[-1] > 1e-6 * ledger[0]  # friction did work
+    assert np.max(np.abs(ledger - ledger[0])) <= 1e-10 * ledger[0]
+    assert res.dissipated[-1] > 1e-3 * ledger[0]  # friction did work (measured 5.3e-3)
 
 
 def test_on_the_modal_plate_friction_drives_the_modes_and_the_ledger_closes():
