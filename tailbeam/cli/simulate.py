@@ -14,7 +14,8 @@ and manifest.json into DIR, for every scene (tailbeam.results.result); timeserie
 when the solver keeps the balls' states (single balls, rigid or modal plate: not the stream
 solver); on a modal plate with sensors also sensors.csv, sensor_spectra.csv and one
 sensor_<name>.png (time and spectrum) per sensor. --export uff58 also writes the sensor records
-as DIR/uff/<scene>.uff and DIR/uff/labels.csv (tailbeam.cli.export).
+as DIR/uff/<scene>.uff and DIR/uff/labels.csv (tailbeam.cli.export); --vtk (--vtk-rate HZ) a
+ParaView time series of the particles and the plate in DIR/vtk/ (tailbeam.io.paraview).
 
 Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
 scene and --out are fully validated before the solver runs, and the results replace DIR

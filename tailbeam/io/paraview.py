@@ -39,7 +39,7 @@ from tailbeam.scene import LABELS
 DEFAULT_RATE_HZ = 200.0
 MAX_FRAMES = 5000  # frames per series
 MAX_FRAMES_BYTES = 1e9  # the particles' states kept at the frames (BallFrames)
-CHUNK_FRAMES = 64  # structure frames computed at once: chunk x points x 3 floats
+CHUNK_BYTES = 2e8  # the structure's displacements computed at once (frames x points x 3)
 LABEL_CODES = {name: code for code, name in enumerate(LABELS)}
 
 
@@ -112,10 +112,14 @@ def flat_plate(scene, result) -> Structure:
     return ModalStructure(points, [("triangle", tris)], shapes, result.plate.modal_coordinates)
 
 
+def frame_count(duration: float, rate: float) -> int:
+    """How many frames k / ``rate`` (Hz), k = 0, 1, ..., lie within ``duration`` (s)."""
+    return int(math.floor(duration * rate * (1.0 + 1e-12))) + 1
+
+
 def frame_times(duration: float, rate: float) -> np.ndarray:
     """k / ``rate`` (Hz) for k = 0, 1, ... up to ``duration`` (s)."""
-    n = int(math.floor(duration * rate * (1.0 + 1e-12))) + 1
-    return np.arange(n, dtype=float) / rate
+    return np.arange(frame_count(duration, rate), dtype=float) / rate
 
 
 def check_rate(rate, duration: float, n_bodies: int, field_name: str = "--vtk-rate"):
@@ -130,14 +134,13 @@ def check_rate(rate, duration: float, n_bodies: int, field_name: str = "--vtk-ra
         raise InputError(
             field_name, f"must be >= 1/duration = {1.0 / duration:.6g} Hz (2 frames), got {rate!r}"
         )
-    n = len(frame_times(duration, rate))
-    top = (MAX_FRAMES - 1) / duration
-    if n > MAX_FRAMES:
+    if rate * duration >= MAX_FRAMES:  # floor(rate duration) + 1 frames > MAX_FRAMES
         raise InputError(
             field_name,
-            f"{rate:g} Hz over {duration:g} s gives {n} frames, above {MAX_FRAMES}; "
-            f"at most {top:.6g} Hz",
+            f"{rate:g} Hz over {duration:g} s gives {rate * duration + 1:.6g} frames, above "
+            f"{MAX_FRAMES}; at most {(MAX_FRAMES - 1) / duration:.6g} Hz",
         )
+    n = frame_count(duration, rate)
     need = frame_bytes(n, n_bodies)
     if need > MAX_FRAMES_BYTES:
         raise InputError(
@@ -206,9 +209,9 @@ def _write_structure(folder: Path, structure: Structure, times, rot: np.ndarray,
         meshio.write(folder / "structure.vtu", meshio.Mesh(points, structure.cells))
         bar.update(len(times))
         return ["structure.vtu"] * len(times)
-    names = []
-    for start in range(0, len(times), CHUNK_FRAMES):
-        chunk = structure.displacement(times[start : start + CHUNK_FRAMES])
+    names, chunk_frames = [], max(2, int(CHUNK_BYTES / (24.0 * len(points))))
+    for start in range(0, len(times), chunk_frames):
+        chunk = structure.displacement(times[start : start + chunk_frames])
         for j, u in enumerate(chunk):
             data = {"displacement": u @ rot.T, "deflection": u[:, 2]}
             name = f"structure_{start + j:05d}.vtu"

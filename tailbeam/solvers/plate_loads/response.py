@@ -106,7 +106,9 @@ def plate_response(
     out = empty_outputs(len(phi_pts), n_samples)
     grid = (t0, dt, n_samples)
     batching = (int(batch_nodes), float(node_time_ulps))
-    g, h, seen = _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, grid, batching, out)
+    what = "modal coordinates" if modal else "plate response at the sensors"
+    g, h, seen = _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, grid, batching, out,
+                            what)  # fmt: skip
     r = np.zeros_like(g)
     if quasi_static:
         r = _residual(basis, xyr, pts, seen, g)
@@ -177,10 +179,11 @@ def node_jumps(loads, t0: float, dt: float, n_samples: int) -> dict:
     return {"df": df, "ds": ds, "target": target, "last": last}
 
 
-def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, out):
+def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, out, what):
     """Run ``march`` over all samples, the nodes in batches of ``batch_nodes`` (their pieces'
     mode shapes evaluated per batch); times = (t0 s, dt s, N), batching = (batch_nodes,
-    node_time_ulps). Returns G, H (pieces, p) and which pieces were seen."""
+    node_time_ulps); ``what`` names the progress. Returns G, H (pieces, p) and which pieces
+    were seen."""
     n_pieces = xyr.shape[0]
     t0, dt, n_samples = times
     batch_nodes, ulps = batching
@@ -199,7 +202,7 @@ def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, 
     order = np.argsort(nodes["target"], kind="stable")
     n_act = int(np.searchsorted(nodes["target"], n_samples, sorter=order))
     done = -1
-    with task("plate response at the sensors", total=max(n_act, 1), unit="load nodes") as bar:
+    with task(what, total=max(n_act, 1), unit="load nodes") as bar:
         start = 0
         while start < n_act:
             stop = min(start + batch_nodes, n_act)
