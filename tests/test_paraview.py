@@ -11,6 +11,8 @@ and ElementTree (the .pvd collections), against independent truths.
   point equals the kept modes' response evaluated at those points by another path (the
   single-ball replay at points; the stream's load response at points), and the displacement
   is that deflection along the plate's normal.
+- A structure of another kind (a volume mesh's 3-vector modes) plugs in through the
+  protocol: its frames hold R sum_k shape_k q_k(t) on its own cells.
 - A bad --vtk-rate or a solver without frames: one line, exit 2, nothing written.
 - `tailbeam modes --vtu --mesh`: the mesh covers the plate at z = 0 and the first mode has
   the SSSS closed-form amplitude.
@@ -21,6 +23,7 @@ import json
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from types import SimpleNamespace
 
 import meshio
 import numpy as np
@@ -30,9 +33,10 @@ from vtk.util.numpy_support import vtk_to_numpy
 
 from tailbeam import simulate
 from tailbeam.cli.main import main
-from tailbeam.io.paraview import write_series
+from tailbeam.io.paraview import ModalStructure, write_series
 from tailbeam.io.scene_file import load_scene
 from tailbeam.physics.bodies import STANDARD_GRAVITY
+from tailbeam.results.frames import BallFrames
 from tailbeam.solvers.plate_loads.response import plate_response
 
 INCLINED = """duration = 0.5
@@ -219,6 +223,27 @@ def test_stream_modal_plate_deflection_is_the_load_response_at_the_points(tmp_pa
     w = plate_response(response.basis, response.zeta, response.loads, points, times,
                        quasi_static=False)["w"]  # fmt: skip
     check_field(frames, w, rot)
+
+
+def test_a_volume_structure_plugs_in_through_the_protocol(tmp_path):
+    """A tetrahedron moving in two 3-vector modes, q(t) = (sin 50 t, cos 50 t): each frame's
+    displacement is R sum_k shape_k q_k(t), its cell a VTK tetra."""
+    rng = np.random.default_rng(3)
+    shapes = rng.normal(size=(4, 3, 2))
+    points = np.array([[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0], [0, 0, -0.1]], dtype=float)
+    structure = ModalStructure(points, [("tetra", np.array([[0, 1, 2, 3]]))], shapes,
+                               lambda t: np.vstack([np.sin(50 * t), np.cos(50 * t)]))  # fmt: skip
+    times = np.arange(5) / 100.0
+    run = SimpleNamespace(frames=BallFrames.empty(times, 0), particles=())
+    write_series(tmp_path / "vtk", SimpleNamespace(inclination=30.0), run, structure)
+    rot = rotation(30.0)
+    for t, name in zip(*read_pvd(tmp_path / "vtk/structure.pvd"), strict=True):
+        xyz, fields = read_vtu(tmp_path / "vtk" / name)
+        np.testing.assert_allclose(xyz, points @ rot.T, atol=1e-15)
+        u = shapes @ np.array([np.sin(50 * t), np.cos(50 * t)])
+        np.testing.assert_allclose(fields["displacement"], u @ rot.T, atol=1e-14)
+        np.testing.assert_allclose(fields["deflection"], u[:, 2], atol=1e-14)
+    assert meshio.read(tmp_path / "vtk/structure_00002.vtu").cells[0].type == "tetra"
 
 
 @pytest.mark.parametrize("rate", ["0", "-5", "nan", "inf", "1e9", "1"])

@@ -17,8 +17,9 @@ axes (cos t, 0, -sin t), (0, 1, 0), (sin t, 0, cos t); the origin stays at the c
 impact face. For a horizontal plate the two frames are the same.
 
 The structure is anything that follows ``Structure`` (points, cells, and the displacement
-field at any times): the flat plate's modes on its FE mesh now (``ModalStructure``), a volume
-mesh's mode shapes (3-vectors) the same way.
+field at any times): the flat plate's modes on its FE mesh now (``ModalStructure``); a basis
+on a volume or shell mesh plugs in by offering ``vtk_structure()`` (its points, cells and
+3-vector mode shapes: ``structure_of``).
 """
 
 import math
@@ -96,15 +97,20 @@ class StillStructure:
         return np.zeros((len(np.atleast_1d(times)), len(self.points), 3))
 
 
-def flat_plate(scene, result) -> Structure:
-    """The scene's flat plate: its kept modes on the FE mesh of the modal plate
-    (``tailbeam.plate.export.surface``, as ``tailbeam modes --vtu``), or the rigid plate as
-    a rectangle. The modal displacement is that of the kept modes (the band); the truncated
-    modes' local quasi-static dent under a contact is not in it."""
+def structure_of(scene, result) -> Structure:
+    """The run's structure: the rigid plate as a rectangle; on the modal plate its kept modes
+    (the band) moved by the run's modal coordinates, on the points, cells and 3-vector mode
+    shapes the basis gives by ``basis.vtk_structure()`` where it has one (a structure of its
+    own mesh), else on the flat plate's FE mesh (``tailbeam.plate.export.surface``, as
+    ``tailbeam modes --vtu``). The truncated modes' local quasi-static dent under a contact
+    is not in the displacement."""
     if result.plate is None:
         points, tris = grid_surface(scene.plate.size_x, scene.plate.size_y, 1)
         return StillStructure(points, [("triangle", tris)])
     basis = result.plate.basis
+    own = getattr(basis, "vtk_structure", None)
+    if own is not None:  # (points (p, 3) m, cells, shapes (p, 3, m) 1/sqrt(kg))
+        return ModalStructure(*own(), result.plate.modal_coordinates)
     points, tris = surface(basis)
     phi = basis.deflection(points[:, :2])
     shapes = np.zeros((len(points), 3, phi.shape[1]))
@@ -164,11 +170,11 @@ def material_codes(particles) -> dict:
 
 
 def write_series(folder, scene, result, structure: Structure | None = None) -> list:
-    """Write ``result.frames`` and the structure (default ``flat_plate``) into ``folder``
+    """Write ``result.frames`` and the structure (default ``structure_of``) into ``folder``
     (created); returns the two ``.pvd`` paths."""
     folder = Path(folder)
     folder.mkdir()
-    structure = structure if structure is not None else flat_plate(scene, result)
+    structure = structure if structure is not None else structure_of(scene, result)
     rot = to_world(scene.inclination)
     times = result.frames.times
     with task(f"ParaView series, {len(times)} frames", total=2 * len(times), unit="files") as bar:
