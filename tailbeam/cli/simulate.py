@@ -141,8 +141,10 @@ def vtk_frames(args, scene, solver):
 
 
 def write_vtk(out_dir, scene, result) -> list:
-    """DIR/vtk/: the ParaView series of ``result.frames`` (tailbeam.io.paraview)."""
+    """DIR/vtk/: the ParaView series of ``result.frames`` (tailbeam.io.paraview); its size
+    said on stderr."""
     from tailbeam.io import paraview
+    from tailbeam.progress import note
 
     pvds = paraview.write_series(Path(out_dir) / "vtk", scene, result)
     codes = paraview.material_codes(result.particles)
@@ -153,6 +155,7 @@ def write_vtk(out_dir, scene, result) -> list:
     describe(pvds[0], units={"radius": "m", "velocity": "m/s", "position": "m"},
              material_codes=codes, label_codes=paraview.LABEL_CODES, **meta)  # fmt: skip
     describe(pvds[1], units={"displacement": "m", "deflection": "m", "position": "m"}, **meta)
+    note(f"--vtk: {len(result.frames.times)} frames, {size / 1e6:.3g} MB in DIR/vtk")
     return pvds
 
 
