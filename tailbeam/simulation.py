@@ -23,6 +23,7 @@ import contextlib
 
 from tailbeam.errors import InputError
 from tailbeam.progress import quiet
+from tailbeam.results.frames import check_frame_times
 from tailbeam.scene import Scene
 from tailbeam.solvers.base import Options, Solver
 from tailbeam.solvers.modal_setup.setup import single_ball_setup, stream_setup
@@ -34,7 +35,7 @@ SOLVERS = {s.name: s for s in (SingleBall(), Stream(), StreamReference())}
 CHOICES = ("auto", *SOLVERS)
 
 
-def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
+def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True, frames=()):
     """Simulate ``scene`` and return its result.
 
     Parameters
@@ -51,6 +52,10 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
         Step budget (rigid: per ball; stream solver: in all); WorkLimitError beyond it.
     progress : bool
         Show progress and the automatic choices on stderr (``tailbeam.progress``).
+    frames : sequence of float
+        Times (s, increasing, within [0, duration]) at which the result keeps every body's
+        position and velocity (``result.frames``, ``tailbeam.results.frames``); memory
+        frames x bodies x 48 bytes. Refused for a solver that cannot (stream-reference).
 
     Returns
     -------
@@ -63,7 +68,10 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
     if not isinstance(scene, Scene):
         raise InputError("scene", f"must be a tailbeam.scene.Scene, got {type(scene).__name__}")
     method = choose_solver(scene, solver)
-    options = Options(rtol=rtol, max_steps=max_steps)
+    frames = check_frame_times(frames, scene.duration) if len(frames) else ()
+    if frames and not method.frames:
+        raise InputError("frames", f"the {method.name!r} solver keeps no states at frame times")
+    options = Options(rtol=rtol, max_steps=max_steps, frames=frames)
     with contextlib.nullcontext() if progress else quiet():
         method.check(scene, options)
         cost = announce_run(scene, method)

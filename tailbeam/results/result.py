@@ -8,7 +8,9 @@ result holds, not a subclass:
   came to rest; the single-ball solvers keep it (rigid and modal plate), the stream solvers
   keep their records only (memory must not grow with steps x particles);
 - ``plate`` (``PlateResponse``): the modal plate's response, which gives the sensors' signals
-  (``sensor_outputs``); None on the rigid plate.
+  (``sensor_outputs``) and the modal coordinates at any times; None on the rigid plate;
+- ``frames`` (``tailbeam.results.frames.BallFrames``): every body's position and velocity at
+  the frame times a run was asked for (``simulate(scene, frames=times)``), else None.
 
 Columns of ``impacts_table()`` (one row per ball per contact; a ball-ball contact gives one
 row for each of the two balls), in this order:
@@ -42,6 +44,7 @@ from typing import Protocol
 import numpy as np
 
 from tailbeam.errors import InputError, require_positive
+from tailbeam.results.frames import BallFrames
 
 IMPACT_COLUMNS = (
     "ball", "index", "t_start", "t_end", "v_in", "v_out", "restitution", "peak_force",
@@ -91,9 +94,15 @@ class PlateResponse(Protocol):
     """The modal plate's response during a run (a part of ``Result`` on the modal plate).
 
     ``sensor_outputs(sensors, duration)`` gives name -> ``tailbeam.signals.sensor.SensorOutput``
-    of the ``SensorSpec``s ``sensors`` over [0, duration] s."""
+    of the ``SensorSpec``s ``sensors`` over [0, duration] s; ``modal_coordinates(times)`` the
+    kept modes' coordinates q (n_modes, len(times)) (sqrt(kg) m) at uniform ``times`` (s) of
+    the mass-normalised shapes of ``basis``."""
+
+    basis: object
 
     def sensor_outputs(self, sensors, duration: float) -> dict: ...
+
+    def modal_coordinates(self, times) -> np.ndarray: ...
 
 
 @dataclass(eq=False)
@@ -131,6 +140,8 @@ class Result:
     angular_velocity : dict
         Name -> angular velocity (3,) rad/s of the bodies whose spin the solver followed
         (friction), when they left or at the end; the others keep their initial one.
+    frames : BallFrames or None
+        Every body's state at the frame times the run was asked for.
     """
 
     duration: float
@@ -146,6 +157,7 @@ class Result:
     states: BallStates | None = field(default=None, repr=False)
     plate: PlateResponse | None = field(default=None, repr=False)
     angular_velocity: dict = field(default_factory=dict, repr=False)
+    frames: BallFrames | None = field(default=None, repr=False)
 
     @property
     def plate_model(self) -> str:

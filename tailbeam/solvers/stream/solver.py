@@ -85,6 +85,7 @@ class Stream(Solver):
                 scene.particles, scene.incline, scene.duration, laws=scene.contacts(),
                 rtol=rtol, max_steps=max_steps, progress=advance, setup=plate,
                 sensors=scene.sensors, info={"solver_choice": self.name}, streams=scene.streams,
+                frames=options.frames,
             )  # fmt: skip
 
     def _announce(self, scene, rtol, max_steps):
@@ -102,6 +103,7 @@ class StreamReference(Stream):
 
     name = "stream-reference"
     label = "stream reference (scipy DOP853, all pairs watched)"
+    frames = False  # it keeps its steps, not states at chosen times
     max_particles = REFERENCE_MAX_PARTICLES
     rtol, max_steps = REFERENCE_RTOL, REFERENCE_MAX_STEPS
 
@@ -140,7 +142,7 @@ class StreamReference(Stream):
 def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
                     rtol: float = DEFAULT_RTOL, max_steps: int = DEFAULT_MAX_STEPS,
                     progress=True, rest_speed: float = DEFAULT_REST_SPEED, setup=None,
-                    sensors=(), info=None, streams=()) -> Result:  # fmt: skip
+                    sensors=(), info=None, streams=(), frames=()) -> Result:  # fmt: skip
     """The fast stream solver on ``particles`` (``tailbeam.streams.generator.Particle``).
 
     Parameters
@@ -165,11 +167,13 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         The streams ``particles`` come from: what each delivered goes to ``info["streams"]``
         (``tailbeam.streams.delivery``) and is said on stderr; the largest release delay (s)
         of any particle to ``stats["release_delay_max"]``.
+    frames : sequence of float
+        Frame times (s): every ball's state there goes to the result's ``frames``.
     """
     run = solve_stream(
         particles, incline, duration, rtol=rtol, rest_speed=rest_speed, max_work=max_steps,
         progress=progress, plate=_stream_plate(setup),
-        contacts=contact_table(particles, laws, incline.plate.material),
+        contacts=contact_table(particles, laws, incline.plate.material), frames=frames,
     )  # fmt: skip
     number_contacts(run.contacts, run.leaves, incline)
     flow = _delivered(streams, particles, run, duration)
@@ -179,7 +183,7 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         leaves=run.leaves, status=run.status, message=run.message, stats=run.stats,
         info={"solver": "fast stream solver (event-driven, active-set DOP853)",
               **(setup.info() if setup else {}), **flow, **(info or {})},
-        sensors=tuple(sensors), plate=_response(setup, run),
+        sensors=tuple(sensors), plate=_response(setup, run), frames=run.frames,
     )  # fmt: skip
 
 
