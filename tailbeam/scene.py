@@ -16,6 +16,7 @@ from tailbeam.errors import (
 from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball, Plate
 from tailbeam.physics.contact_law import HERTZ_EXPONENT, ImpactLaw, ball_plate_law
 from tailbeam.physics.contacts import PLATE, ContactTable
+from tailbeam.physics.friction import FrictionModel
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import Material
 from tailbeam.signals.sensor import SensorSpec
@@ -170,7 +171,9 @@ class Scene:
     there is g (sin theta, 0, -cos theta), tailbeam.physics.incline). streams: validated
     stream settings (tailbeam.streams.generator.StreamSettings); their particles
     (``particles``) are generated deterministically from the seeds when first asked for.
-    labels: ``coal`` or ``gangue`` per ball (default: ``default_label``).
+    labels: ``coal`` or ``gangue`` per ball (default: ``default_label``). friction: the
+    contacts' friction and rolling resistance (``tailbeam.physics.friction.FrictionModel``),
+    None for frictionless contacts (the paper's setting).
     """
 
     balls: tuple[Ball, ...]
@@ -185,6 +188,7 @@ class Scene:
     inclination: float = 0.0
     streams: tuple = ()
     labels: tuple[str, ...] = ()
+    friction: FrictionModel | None = None
 
     def __post_init__(self):
         require_positive("duration", self.duration)
@@ -211,6 +215,8 @@ class Scene:
             )
         self._check_labels()
         self._check_streams()
+        if self.friction is not None and not isinstance(self.friction, FrictionModel):
+            raise InputError("contact.friction", "must be a FrictionModel (or None: frictionless)")
         sensor_names = [s.name for s in self.sensors]
         if len(set(sensor_names)) != len(sensor_names):
             raise InputError("sensors", "sensor names must be unique")

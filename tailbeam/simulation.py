@@ -11,7 +11,10 @@ each following one protocol (``tailbeam.solvers.base.Solver``):
 - ``"stream"``: the fast stream solver, on the rigid or the modal plate; it runs every scene;
 - ``"stream-reference"``: the slow independent reference of the stream solver (scipy DOP853,
   every pair watched, at most ``REFERENCE_MAX_PARTICLES`` bodies), on the rigid plate;
-- ``"auto"`` (the default): ``"single-ball"`` where it can run, else ``"stream"``.
+- ``"auto"`` (the default): ``"single-ball"`` where it can run, else ``"stream"``; a scene
+  with friction (``[contact.friction]``): ``"stream-reference"``, the one solver that models
+  it, if it can run the scene (rigid plate, at most ``REFERENCE_MAX_PARTICLES`` bodies), else
+  refused.
 
 Running one scene through two solvers is how a user checks one against the other.
 """
@@ -20,6 +23,7 @@ import contextlib
 
 from tailbeam.errors import InputError
 from tailbeam.progress import quiet
+from tailbeam.results.frames import check_frame_times
 from tailbeam.scene import Scene
 from tailbeam.solvers.base import Options, Solver
 from tailbeam.solvers.modal_setup.setup import single_ball_setup, stream_setup
@@ -31,7 +35,7 @@ SOLVERS = {s.name: s for s in (SingleBall(), Stream(), StreamReference())}
 CHOICES = ("auto", *SOLVERS)
 
 
-def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
+def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True, frames=()):
     """Simulate ``scene`` and return its result.
 
     Parameters
@@ -48,6 +52,10 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
         Step budget (rigid: per ball; stream solver: in all); WorkLimitError beyond it.
     progress : bool
         Show progress and the automatic choices on stderr (``tailbeam.progress``).
+    frames : sequence of float
+        Times (s, increasing, within [0, duration]) at which the result keeps every body's
+        position and velocity (``result.frames``, ``tailbeam.results.frames``); memory
+        frames x bodies x 48 bytes. Refused for a solver that cannot (stream-reference).
 
     Returns
     -------
@@ -60,7 +68,10 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True):
     if not isinstance(scene, Scene):
         raise InputError("scene", f"must be a tailbeam.scene.Scene, got {type(scene).__name__}")
     method = choose_solver(scene, solver)
-    options = Options(rtol=rtol, max_steps=max_steps)
+    frames = check_frame_times(frames, scene.duration) if len(frames) else ()
+    if frames and not method.frames:
+        raise InputError("frames", f"the {method.name!r} solver keeps no states at frame times")
+    options = Options(rtol=rtol, max_steps=max_steps, frames=frames)
     with contextlib.nullcontext() if progress else quiet():
         method.check(scene, options)
         cost = announce_run(scene, method)
@@ -76,12 +87,30 @@ def choose_solver(scene, solver: str = "auto", field: str = "solver") -> Solver:
     that does not exist or cannot run the scene."""
     if solver not in CHOICES:
         raise InputError(field, f"must be one of {', '.join(CHOICES)}; got {solver!r}")
+    if solver == "auto" and scene.friction is not None:
+        return _friction_solver(scene, field)
     if solver == "auto":
         solver = "stream" if scene.needs_stream_solver else "single-ball"
     method = SOLVERS[solver]
     why = method.refusal(scene)
     if why:
         raise InputError(field, why)
+    return method
+
+
+def _friction_solver(scene, field: str) -> Solver:
+    """The solver "auto" picks for a scene with friction: the stream reference, or an
+    InputError naming ``contact.friction`` when it cannot run the scene."""
+    method = SOLVERS["stream-reference"]
+    why = method.refusal(scene)
+    n = len(scene.particles)
+    if why is None and n > method.max_particles:
+        why = f"{n} particles, above its limit of {method.max_particles}"
+    if why:
+        raise InputError(
+            "contact.friction", "only the stream reference models friction and it cannot run "
+            f"this scene ({why}); remove [contact.friction] to run it frictionless"
+        )  # fmt: skip
     return method
 
 

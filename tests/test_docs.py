@@ -20,6 +20,8 @@ from tailbeam.io.scene_dump import MATERIAL_KEYS
 from tailbeam.io.scene_file import (
     BALL_KEYS,
     CONTACT_KEYS,
+    FRICTION_KEYS,
+    FRICTION_PAIR_KEYS,
     MODAL_KEYS,
     NOISE_KEYS,
     PLATE_KEYS,
@@ -51,6 +53,8 @@ def scene_keys() -> list:
     """Every key of a scene file, as the manual names it."""
     names = list(TOP_KEYS)
     names += [f"contact.{k}" for k in CONTACT_KEYS]
+    names += [f"contact.friction.{k}" for k in FRICTION_KEYS]
+    names += [f"contact.friction.pairs.{k}" for k in FRICTION_PAIR_KEYS]
     names += [f"plate.{k}" for k in PLATE_KEYS + MODAL_KEYS]
     names += [f"materials.NAME.{k}" for k in MATERIAL_KEYS]
     names += [f"balls.{k}" for k in BALL_KEYS]

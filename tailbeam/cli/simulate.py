@@ -14,7 +14,8 @@ and manifest.json into DIR, for every scene (tailbeam.results.result); timeserie
 when the solver keeps the balls' states (single balls, rigid or modal plate: not the stream
 solver); on a modal plate with sensors also sensors.csv, sensor_spectra.csv and one
 sensor_<name>.png (time and spectrum) per sensor. --export uff58 also writes the sensor records
-as DIR/uff/<scene>.uff and DIR/uff/labels.csv (tailbeam.cli.export).
+as DIR/uff/<scene>.uff and DIR/uff/labels.csv (tailbeam.cli.export); --vtk (--vtk-rate HZ) a
+ParaView time series of the particles and the plate in DIR/vtk/ (tailbeam.io.paraview).
 
 Bad input is reported as one line on stderr with exit code 2, and nothing is written: the
 scene and --out are fully validated before the solver runs, and the results replace DIR
@@ -56,6 +57,20 @@ def add_arguments(parser):
         "rigid plate, <= 20 bodies): run one scene through two to compare them",
     )
     export.add_export_option(parser, "the sensor records (DIR/uff/)")
+    parser.add_argument(
+        "--vtk",
+        action="store_true",
+        help="also write a ParaView time series of the particles and the plate: "
+        "DIR/vtk/particles.pvd and DIR/vtk/structure.pvd (docs/paraview.md)",
+    )
+    parser.add_argument(
+        "--vtk-rate",
+        type=float,
+        default=None,
+        metavar="HZ",
+        help="frames per simulated second of the --vtk series; giving it implies --vtk "
+        "(default: 200)",
+    )
 
 
 def write_results(out_dir, scene, result) -> list:
@@ -106,6 +121,44 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
     return files
 
 
+def vtk_frames(args, scene, solver):
+    """The frame times of --vtk (empty without it), refused before the work (InputError
+    naming --vtk or --vtk-rate) for a solver that keeps no states or an absurd rate."""
+    from tailbeam.io import paraview
+    from tailbeam.progress import note
+
+    if not (args.vtk or args.vtk_rate is not None):
+        return ()
+    if not solver.frames:
+        raise InputError(
+            "--vtk", f"the {solver.name!r} solver keeps no states at frame times; use "
+            "--solver stream or auto"
+        )  # fmt: skip
+    rate = paraview.DEFAULT_RATE_HZ if args.vtk_rate is None else args.vtk_rate
+    times = paraview.check_rate(rate, scene.duration, len(scene.particles), "--vtk-rate")
+    note(f"--vtk: {len(times)} frames at {rate:g} Hz, world frame (z up), into DIR/vtk")
+    return times
+
+
+def write_vtk(out_dir, scene, result) -> list:
+    """DIR/vtk/: the ParaView series of ``result.frames`` (tailbeam.io.paraview); its size
+    said on stderr."""
+    from tailbeam.io import paraview
+    from tailbeam.progress import note
+
+    pvds = paraview.write_series(Path(out_dir) / "vtk", scene, result)
+    codes = paraview.material_codes(result.particles)
+    size = sum(f.stat().st_size for f in (Path(out_dir) / "vtk").iterdir())
+    meta = {"frame": "world: the plate frame turned by the inclination about y, z up",
+            "inclination_deg": scene.inclination, "frames": len(result.frames.times),
+            "bytes": size}  # fmt: skip
+    describe(pvds[0], units={"radius": "m", "velocity": "m/s", "position": "m"},
+             material_codes=codes, label_codes=paraview.LABEL_CODES, **meta)  # fmt: skip
+    describe(pvds[1], units={"displacement": "m", "deflection": "m", "position": "m"}, **meta)
+    note(f"--vtk: {len(result.frames.times)} frames, {size / 1e6:.3g} MB in DIR/vtk")
+    return pvds
+
+
 def default_out(scene_file, overwrite: bool = False) -> Path:
     """out/<stem of ``scene_file``>, refused (InputError naming --out) when it holds the
     outputs of another scene file or command, unless ``overwrite``."""
@@ -148,15 +201,18 @@ def run(args) -> int:
     solver = choose_solver(scene, args.solver, "--solver")
     if export.chosen(args):
         export.check_run_export(scene)
+    frames = vtk_frames(args, scene, solver)
     if solver.name == "stream":
         announce_first_compile("stream")
     elif solver.name == "single-ball":
         announce_first_compile("rigid" if scene.plate_model == "rigid" else "coupled")
-    result = simulate(scene, solver=solver.name)
+    result = simulate(scene, solver=solver.name, frames=frames)
     with atomic_output_dir(args.out, command=f"tailbeam simulate {args.scene}") as tmp:
         files = write_results(tmp, scene, result)
         if export.chosen(args):
             files += export.write_run_uff(tmp, args.scene, scene, result)
+        if len(frames):
+            files += write_vtk(tmp, scene, result)
         describe(tmp / "impacts.json", scene_file=str(Path(args.scene).resolve()))
     n = len(result.impacts)
     names = ", ".join(f.name for f in files)

@@ -56,6 +56,8 @@ def scene_to_dict(scene: Scene) -> dict:
         "penetration": c.penetration,
         "clamp": c.clamp,
     }
+    if scene.friction is not None:  # written only when set: frictionless scenes echo as before
+        out["contact"]["friction"] = scene.friction.values()
     out["plate"] = plate
     if materials:
         out["materials"] = materials
@@ -87,6 +89,8 @@ def _ball(ball, label: str) -> dict:
         "position": list(ball.position),
         "velocity": list(ball.velocity),
     }
+    if any(ball.angular_velocity):  # written only when set
+        d["angular_velocity"] = list(ball.angular_velocity)
     if label != default_label(ball):  # written only when not the default
         d["label"] = label
     return d
@@ -112,6 +116,8 @@ def stream_to_dict(s) -> dict:
     d["height"] = s.height[0] if s.height[0] == s.height[1] else list(s.height)
     d.update(velocity=list(s.velocity), velocity_spread=s.velocity_spread, seed=s.seed)
     d["max_tries"] = s.max_tries
+    if s.angular_velocity_spread > 0.0:  # written only when set
+        d["angular_velocity_spread"] = s.angular_velocity_spread
     return d
 
 

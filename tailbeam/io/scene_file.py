@@ -22,6 +22,8 @@ from tailbeam.errors import (
 # writing back lives in tailbeam.io.scene_dump; re-exported so existing imports keep working
 from tailbeam.io.scene_dump import MATERIAL_KEYS
 from tailbeam.physics.bodies import Ball, Plate, check_ball_above_plate
+from tailbeam.physics.friction import KEYS as FRICTION_VALUE_KEYS
+from tailbeam.physics.friction import FrictionModel, FrictionSettings
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import Material, get_material
 from tailbeam.preflight import check_scene
@@ -53,7 +55,9 @@ TOP_KEYS = (
     "streams",
 )
 SENSOR_NAME = re.compile(r"[A-Za-z0-9_.+-]+")  # used in file names (sensor_<name>.png)
-CONTACT_KEYS = ("exponent", "damping", "penetration", "clamp")
+CONTACT_KEYS = ("exponent", "damping", "penetration", "clamp", "friction")
+FRICTION_KEYS = FRICTION_VALUE_KEYS + ("pairs",)
+FRICTION_PAIR_KEYS = ("materials",) + FRICTION_VALUE_KEYS
 PLATE_KEYS = ("model", "material", "size", "inclination")
 MODAL_KEYS = (
     "boundary",
@@ -67,7 +71,7 @@ MODAL_KEYS = (
     "tail",
     "tail_modes",
 )
-BALL_KEYS = ("name", "material", "radius", "position", "velocity", "label")
+BALL_KEYS = ("name", "material", "radius", "position", "velocity", "label", "angular_velocity")
 SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance", "noise")
 NOISE_KEYS = ("rms", "background", "band", "seed")
 REQUIRED = ("duration", "balls")  # or duration and streams
@@ -101,8 +105,10 @@ def parse_scene(data: dict) -> Scene:
     """Build a Scene from the parsed TOML table ``data``."""
     _check_keys("", data, TOP_KEYS, required=("duration",) if "streams" in data else REQUIRED)
     materials = _parse_materials(data.get("materials", {}))
-    contact = _parse_contact(_table("contact", data.get("contact", {})))
+    contact_table = _table("contact", data.get("contact", {}))
+    contact = _parse_contact(contact_table)
     plate, model, modal = _parse_plate(_table("plate", data.get("plate", {})), materials)
+    friction = _parse_friction(contact_table, materials, plate)
     kwargs = {}
     if "inclination" in _table("plate", data.get("plate", {})):
         kwargs["inclination"] = data["plate"]["inclination"]
@@ -128,6 +134,7 @@ def parse_scene(data: dict) -> Scene:
         sensors=sensors,
         streams=streams,
         labels=labels,
+        friction=friction,
         **kwargs,
     )
     check_scene(scene)
@@ -206,6 +213,31 @@ def _parse_contact(table: dict) -> ContactSettings:
     return ContactSettings(**kwargs)
 
 
+def _parse_friction(contact: dict, materials: dict, plate: Plate) -> FrictionModel | None:
+    """``[contact.friction]`` and its ``[[contact.friction.pairs]]`` (None if absent)."""
+    if "friction" not in contact:
+        return None
+    table = _table("contact.friction", contact["friction"])
+    _check_keys("contact.friction", table, FRICTION_KEYS, required=("static", "dynamic"))
+    values = {k: table[k] for k in FRICTION_VALUE_KEYS if k in table}
+    model = FrictionModel(FrictionSettings(**values))
+    pairs = []
+    for k, t in enumerate(_array_of_tables("contact.friction.pairs", table.get("pairs", [])), 1):
+        field = f"contact.friction.pairs[{k}]"
+        _check_keys(field, t, FRICTION_PAIR_KEYS, required=("materials",))
+        names = t["materials"]
+        if not isinstance(names, list) or len(names) != 2:
+            raise InputError(
+                f"{field}.materials", f"must be a list of 2 material names, got {names!r}"
+            )
+        for name in names:  # built-in, [materials.NAME] or the plate's
+            if _string(f"{field}.materials", name) != plate.material.name:
+                get_material(name, materials, field=f"{field}.materials")
+        values = {key: t[key] for key in FRICTION_VALUE_KEYS if key in t}
+        pairs.append(model.pair_settings(k, names, values))
+    return FrictionModel(model.default, tuple(pairs))
+
+
 def _parse_plate(table: dict, materials: dict):
     model = table.get("model", "rigid")
     allowed = PLATE_KEYS + MODAL_KEYS if model == "modal" else PLATE_KEYS
@@ -269,7 +301,8 @@ def _parse_balls(value, materials: dict, plate: Plate, has_streams: bool) -> tup
         plausible.check_height(f"{field}.position", position[2], plate)
         velocity = require_vector(f"{field}.velocity", t.get("velocity", (0.0, 0.0, 0.0)), 3)
         plausible.check_speed(f"{field}.velocity", velocity)
-        ball = Ball(name, material, radius, position, velocity)
+        spin = require_vector(f"{field}.angular_velocity", t.get("angular_velocity", (0, 0, 0)), 3)
+        ball = Ball(name, material, radius, position, velocity, spin)
         try:
             check_ball_above_plate(ball, plate)
         except InputError as err:

@@ -19,7 +19,8 @@ STANDARD_GRAVITY = 9.80665  # m/s^2
 class Ball:
     """A homogeneous elastic sphere.
 
-    radius in m, position of the centre [x, y, z] in m, velocity [vx, vy, vz] in m/s.
+    radius in m, position of the centre [x, y, z] in m, velocity [vx, vy, vz] in m/s,
+    angular_velocity [wx, wy, wz] in rad/s (moment of inertia 2/5 m r^2, ``inertia``).
     """
 
     name: str
@@ -27,6 +28,7 @@ class Ball:
     radius: float
     position: tuple[float, float, float]
     velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    angular_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
         field = f"balls[{self.name}]"
@@ -35,11 +37,18 @@ class Ball:
         object.__setattr__(self, "radius", require_positive(f"{field}.radius", self.radius))
         object.__setattr__(self, "position", require_vector(f"{field}.position", self.position, 3))
         object.__setattr__(self, "velocity", require_vector(f"{field}.velocity", self.velocity, 3))
+        spin = require_vector(f"{field}.angular_velocity", self.angular_velocity, 3)
+        object.__setattr__(self, "angular_velocity", spin)
 
     @property
     def mass(self) -> float:
         """kg"""
         return self.material.density * 4.0 / 3.0 * math.pi * self.radius**3
+
+    @property
+    def inertia(self) -> float:
+        """Moment of inertia of the homogeneous sphere, 2/5 m r^2 (kg m^2)."""
+        return 0.4 * self.mass * self.radius**2
 
     @property
     def kinetic_energy(self) -> float:

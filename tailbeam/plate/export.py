@@ -44,20 +44,48 @@ def write_frequencies_csv(
     return path
 
 
+GRID_CELLS = 32  # cells per side of the surface of a basis without a mesh
+
+
+def surface(basis: ModalBasis, mesh=None) -> tuple:
+    """The impact face (z = 0, plate frame) as written for ParaView: (points (p, 3) m,
+    triangles (t, 3)) of a refined copy (VTU_REFINE) of ``mesh`` (default: the basis's own
+    FE mesh), or of a GRID_CELLS x GRID_CELLS grid of the plate for a basis without one."""
+    mesh = mesh if mesh is not None else getattr(basis, "mesh", None)
+    if mesh is None:
+        return grid_surface(basis.plate.size_x, basis.plate.size_y, GRID_CELLS)
+    fine = mesh.refined(VTU_REFINE) if VTU_REFINE else mesh
+    points = np.column_stack([fine.p.T, np.zeros(fine.p.shape[1])])
+    return points, np.ascontiguousarray(fine.t.T)
+
+
+def grid_surface(a: float, b: float, cells: int) -> tuple:
+    """(points (p, 3), triangles (t, 3)) of an ``a`` x ``b`` m rectangle centred on the
+    origin at z = 0, ``cells`` x ``cells`` squares each split in two triangles."""
+    x = np.linspace(-0.5 * a, 0.5 * a, cells + 1)
+    y = np.linspace(-0.5 * b, 0.5 * b, cells + 1)
+    xx, yy = np.meshgrid(x, y, indexing="ij")
+    points = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)])
+    i, j = np.meshgrid(np.arange(cells), np.arange(cells), indexing="ij")
+    n0 = (i * (cells + 1) + j).ravel()
+    n1, n2, n3 = n0 + cells + 1, n0 + cells + 2, n0 + 1
+    tris = np.concatenate([np.column_stack([n0, n1, n2]), np.column_stack([n0, n2, n3])])
+    return points, tris
+
+
 def write_vtu(path, basis: ModalBasis, mesh=None, max_modes: int | None = None) -> Path:
-    """Mode shapes on a refined copy of the FE mesh (default: the basis's own mesh): one
-    point field per mode, 'mode_001_<f>Hz' (deflection, 1/sqrt(kg)); in ParaView use
-    'Warp By Scalar' to see the shape."""
+    """Mode shapes on the impact face (``surface``: a refined copy of the FE mesh, default
+    the basis's own): one point field per mode, 'mode_001_<f>Hz' (deflection normal to the
+    face, + up, 1/sqrt(kg)); in ParaView use 'Warp By Scalar' to see the shape. The points
+    and cells are those of the plate in a ``simulate --vtk`` series (tailbeam.io.paraview)."""
     import meshio
 
-    mesh = mesh if mesh is not None else basis.mesh
-    fine = mesh.refined(VTU_REFINE) if VTU_REFINE else mesh
+    points, triangles = surface(basis, mesh)
     n = basis.n_modes if max_modes is None else min(max_modes, basis.n_modes)
-    phi = basis.deflection(fine.p.T)[:, :n]
+    phi = basis.deflection(points[:, :2])[:, :n]
     width = max(3, len(str(n)))
     data = {f"mode_{i + 1:0{width}d}_{basis.frequencies_hz[i]:.1f}Hz": phi[:, i] for i in range(n)}
-    points = np.column_stack([fine.p.T, np.zeros(fine.p.shape[1])])
-    meshio.write(Path(path), meshio.Mesh(points, [("triangle", fine.t.T)], point_data=data))
+    meshio.write(Path(path), meshio.Mesh(points, [("triangle", triangles)], point_data=data))
     return Path(path)
 
 

@@ -152,6 +152,15 @@ class Impact:
         How the contact ended: ``separated``, ``rest`` (the ball came to rest on the plate:
         the solver's rest rules), ``left`` (the ball left the plate during the contact) or
         ``duration`` (the simulation ended during it); equal to these strings.
+    normal_impulse : float
+        Integral of the pair's normal contact force over the contact (N s); nan where the
+        solver does not integrate it (the single-ball and the fast stream solvers).
+    tangential_impulse : float
+        Magnitude of the integral of the tangential (friction) force on the row's ball over
+        the contact (N s); 0 for a frictionless contact.
+    tangential_end : str
+        How the contact ended tangentially: ``sliding`` (slip speed at least the stiction
+        velocity), ``sticking`` (below it) or ``frictionless``.
     """
 
     ball: str
@@ -170,6 +179,9 @@ class Impact:
     max_penetration: float = 0.0
     next_apex_height: float = float("nan")
     end: End = End.DURATION
+    normal_impulse: float = float("nan")
+    tangential_impulse: float = 0.0
+    tangential_end: str = "frictionless"
 
     @property
     def restitution(self) -> float:

@@ -8,7 +8,9 @@ result holds, not a subclass:
   came to rest; the single-ball solvers keep it (rigid and modal plate), the stream solvers
   keep their records only (memory must not grow with steps x particles);
 - ``plate`` (``PlateResponse``): the modal plate's response, which gives the sensors' signals
-  (``sensor_outputs``); None on the rigid plate.
+  (``sensor_outputs``) and the modal coordinates at any times; None on the rigid plate;
+- ``frames`` (``tailbeam.results.frames.BallFrames``): every body's position and velocity at
+  the frame times a run was asked for (``simulate(scene, frames=times)``), else None.
 
 Columns of ``impacts_table()`` (one row per ball per contact; a ball-ball contact gives one
 row for each of the two balls), in this order:
@@ -23,7 +25,15 @@ row for each of the two balls), in this order:
   plate frame at first touch, m), ``material``, ``radius`` (m) of the row's ball;
 - then ``label`` (coal / gangue), ``stream`` (empty for ``[[balls]]``), ``end`` (``End``),
   ``approach_in``, ``approach_out`` (m/s, the pair's normal approach speed at first touch and
-  its separation speed at the end).
+  its separation speed at the end);
+- then ``normal_impulse`` (N s, the integral of the pair's normal force; nan where the solver
+  does not integrate it), ``tangential_impulse`` (N s, the magnitude of the friction force's
+  integral on the row's ball; 0 without friction) and ``tangential_end`` (``sliding``,
+  ``sticking`` or ``frictionless``).
+
+``particles_table()`` ends with ``wx``, ``wy``, ``wz``: the body's angular velocity (rad/s,
+plate frame) when it left the plate or at the end (``Result.angular_velocity``; without
+friction its initial one, which frictionless contacts never change).
 """
 
 import functools
@@ -34,6 +44,7 @@ from typing import Protocol
 import numpy as np
 
 from tailbeam.errors import InputError, require_positive
+from tailbeam.results.frames import BallFrames
 
 IMPACT_COLUMNS = (
     "ball", "index", "t_start", "t_end", "v_in", "v_out", "restitution", "peak_force",
@@ -46,19 +57,25 @@ IMPACT_UNITS = {
 IMPACT_TABLE_COLUMNS = IMPACT_COLUMNS + (
     "partner", "x", "y", "material", "radius",
     "label", "stream", "end", "approach_in", "approach_out",
+    "normal_impulse", "tangential_impulse", "tangential_end",
 )  # fmt: skip
 IMPACT_TABLE_UNITS = {
     **IMPACT_UNITS, "x": "m", "y": "m", "radius": "m", "approach_in": "m/s", "approach_out": "m/s",
+    "normal_impulse": "N s", "tangential_impulse": "N s",
 }  # fmt: skip
 PARTICLE_COLUMNS = (
     "name", "stream", "material", "label", "radius", "mass", "t_release",
-    "x0", "y0", "z0", "vx0", "vy0", "vz0", "t_leave", "leave_edge",
+    "x0", "y0", "z0", "vx0", "vy0", "vz0", "t_leave", "leave_edge", "wx", "wy", "wz",
 )  # fmt: skip
 PARTICLE_UNITS = {
     "radius": "m", "mass": "kg", "t_release": "s", "x0": "m", "y0": "m", "z0": "m",
     "vx0": "m/s", "vy0": "m/s", "vz0": "m/s", "t_leave": "s",
+    "wx": "rad/s", "wy": "rad/s", "wz": "rad/s",
 }  # fmt: skip
-TEXT_COLUMNS = {"ball", "partner", "material", "label", "stream", "end", "name", "leave_edge"}
+TEXT_COLUMNS = {
+    "ball", "partner", "material", "label", "stream", "end", "name", "leave_edge",
+    "tangential_end",
+}  # fmt: skip
 
 
 class BallStates(Protocol):
@@ -77,9 +94,15 @@ class PlateResponse(Protocol):
     """The modal plate's response during a run (a part of ``Result`` on the modal plate).
 
     ``sensor_outputs(sensors, duration)`` gives name -> ``tailbeam.signals.sensor.SensorOutput``
-    of the ``SensorSpec``s ``sensors`` over [0, duration] s."""
+    of the ``SensorSpec``s ``sensors`` over [0, duration] s; ``modal_coordinates(times)`` the
+    kept modes' coordinates q (n_modes, len(times)) (sqrt(kg) m) at uniform ``times`` (s) of
+    the mass-normalised shapes of ``basis``."""
+
+    basis: object
 
     def sensor_outputs(self, sensors, duration: float) -> dict: ...
+
+    def modal_coordinates(self, times) -> np.ndarray: ...
 
 
 @dataclass(eq=False)
@@ -114,6 +137,11 @@ class Result:
         The balls' states at any time (single-ball solvers).
     plate : PlateResponse or None
         The modal plate's response; None on the rigid plate.
+    angular_velocity : dict
+        Name -> angular velocity (3,) rad/s of the bodies whose spin the solver followed
+        (friction), when they left or at the end; the others keep their initial one.
+    frames : BallFrames or None
+        Every body's state at the frame times the run was asked for.
     """
 
     duration: float
@@ -128,6 +156,8 @@ class Result:
     sensors: tuple = ()
     states: BallStates | None = field(default=None, repr=False)
     plate: PlateResponse | None = field(default=None, repr=False)
+    angular_velocity: dict = field(default_factory=dict, repr=False)
+    frames: BallFrames | None = field(default=None, repr=False)
 
     @property
     def plate_model(self) -> str:
@@ -148,22 +178,24 @@ class Result:
             rows.append(
                 (*(getattr(rec, c) for c in IMPACT_COLUMNS), rec.partner, rec.x, rec.y,
                  p.material.name, p.radius, p.label, p.stream, str(rec.end), rec.approach_in,
-                 rec.approach_out)
+                 rec.approach_out, rec.normal_impulse, rec.tangential_impulse,
+                 rec.tangential_end)
             )  # fmt: skip
         return columns(IMPACT_TABLE_COLUMNS, rows)
 
     def particles_table(self) -> dict:
         """particles.csv as columns: name -> numpy array, in ``PARTICLE_COLUMNS`` order: the
         release state of every body (plate frame), its leave time (s, nan if it never left)
-        and edge (empty if it never left)."""
+        and edge (empty if it never left), its final angular velocity (rad/s)."""
         leave = {e.ball: e for e in self.leaves}
         rows = []
         for p in self.particles:
             e = leave.get(p.name)
+            spin = self.angular_velocity.get(p.name, p.angular_velocity)
             rows.append(
                 (p.name, p.stream, p.material.name, p.label, p.radius, p.mass, p.t_release,
                  *p.position, *p.velocity,
-                 e.time if e else math.nan, e.edge if e else "")
+                 e.time if e else math.nan, e.edge if e else "", *(float(w) for w in spin))
             )  # fmt: skip
         return columns(PARTICLE_COLUMNS, rows)
 

@@ -30,10 +30,14 @@ class Options:
         Relative tolerance of the solver's integrator (None: its default).
     max_steps : int, optional
         The solver's work bound in steps (None: its default); WorkLimitError beyond it.
+    frames : tuple of float
+        Times (s) at which the result keeps every body's state (``Result.frames``); empty:
+        none. Not a setting of the integration (``given`` leaves it out).
     """
 
     rtol: float | None = None
     max_steps: int | None = None
+    frames: tuple = ()
 
     def given(self) -> dict:
         """The settings the user gave, by name."""
@@ -51,10 +55,13 @@ class Solver(abc.ABC):
     stream : bool
         True if it runs on the stream solvers' modal set-up (``stream_setup``: the sensors'
         band, contact tails), False for the single-ball set-up.
+    frames : bool
+        True if it can keep every body's state at frame times (``Options.frames``).
     """
 
     name: str = ""
     stream: bool = False
+    frames: bool = True
 
     def refusal(self, scene) -> str | None:
         """Why this solver cannot run ``scene`` (one phrase naming what to change), or None."""

@@ -4,6 +4,7 @@ for scenes without streams, without inclination and without two balls that can t
 
 from tailbeam.errors import InputError
 from tailbeam.progress import task
+from tailbeam.results.frames import BallFrames
 from tailbeam.results.result import Result
 from tailbeam.scene import Scene
 from tailbeam.solvers.base import Options, Solver, why_stream
@@ -20,6 +21,11 @@ class SingleBall(Solver):
     stream = False
 
     def refusal(self, scene) -> str | None:
+        if scene.friction is not None:
+            return (
+                "contact.friction: 'single-ball' models frictionless contacts only; friction "
+                "and rotation run on --solver stream-reference"
+            )
         if not scene.needs_stream_solver:
             return None
         return (
@@ -34,7 +40,14 @@ class SingleBall(Solver):
             )
 
     def run(self, scene, plate, options: Options, **coupled) -> Result:
-        """``coupled``: settings of ``simulate_coupled`` (e.g. ``steps_per_contact``)."""
+        """``coupled``: settings of ``simulate_coupled`` (e.g. ``steps_per_contact``); the
+        frames (``options.frames``) sampled from the balls' solutions."""
+        result = self._solve(scene, plate, options, **coupled)
+        if options.frames:
+            result.frames = BallFrames.from_states(result, options.frames)
+        return result
+
+    def _solve(self, scene, plate, options: Options, **coupled) -> Result:
         if plate is None:
             return self._rigid(scene, options)
         settings = plate.settings

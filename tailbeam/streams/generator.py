@@ -17,6 +17,8 @@ tables; keys below, SI units, plate frame of ``tailbeam.physics.incline``):
                      a number or [min, max] (uniform)
     velocity         mean release velocity [vx, vy, vz] in m/s (default [0, 0, 0])
     velocity_spread  standard deviation of each velocity component, m/s (default 0)
+    angular_velocity_spread  standard deviation of each angular velocity component (mean
+                     0), rad/s (default 0: the particles do not spin)
     seed             integer >= 0 (default 0)
     max_tries        placement attempts per particle (default 100)
 
@@ -24,7 +26,7 @@ Arrivals are a Poisson process (independent exponential gaps of mean 1/rate): gi
 number, the release times are uniform on [start, stop).
 
 Randomness: each stream owns numpy Generators on the PCG64 bit generator seeded by
-SeedSequence(seed), one per quantity (arrivals, labels, radii, velocities, positions), and
+SeedSequence(seed), one per quantity (arrivals, labels, radii, velocities, positions, spins), and
 only draws uniform doubles, turned into each distribution by its inverse CDF (scipy.special
 ndtr/ndtri for the normal and lognormal). The stream depends on nothing but the seed and the
 settings (no dict order, no hashing); PCG64's stream is stable across numpy versions and
@@ -61,6 +63,7 @@ KEYS = (
     "name", "rate", "start", "stop", "gangue_fraction", "coal_material", "gangue_material",
     "radius", "size_distribution", "median", "sigma", "characteristic_radius", "uniformity",
     "area", "height", "velocity", "velocity_spread", "seed", "max_tries",
+    "angular_velocity_spread",
 )  # fmt: skip
 DISTRIBUTIONS = {
     "uniform": (),
@@ -92,11 +95,13 @@ class StreamSettings:
     velocity_spread: float
     seed: int
     max_tries: int
+    angular_velocity_spread: float = 0.0
 
 
 @dataclass(frozen=True)
 class Particle:
-    """A released particle: position (m) and velocity (m/s) at its release time t_release."""
+    """A released particle: position (m), velocity (m/s) and angular velocity (rad/s) at its
+    release time t_release."""
 
     name: str
     stream: str
@@ -107,16 +112,18 @@ class Particle:
     t_release: float
     position: tuple
     velocity: tuple
+    angular_velocity: tuple = (0.0, 0.0, 0.0)
 
     def ball(self) -> Ball:
         """The particle as a ``tailbeam.Ball`` at its release state."""
-        return Ball(self.name, self.material, self.radius, self.position, self.velocity)
+        return Ball(self.name, self.material, self.radius, self.position, self.velocity,
+                    self.angular_velocity)  # fmt: skip
 
     @classmethod
     def from_ball(cls, ball: Ball, label: str) -> "Particle":
         """A ``[[balls]]`` entry as a particle: no stream, released at 0 s, labelled ``label``."""
         return cls(ball.name, "", label, ball.material, ball.radius, ball.mass, 0.0,
-                   ball.position, ball.velocity)  # fmt: skip
+                   ball.position, ball.velocity, ball.angular_velocity)  # fmt: skip
 
 
 def default_label(ball: Ball) -> str:
@@ -169,9 +176,12 @@ def parse_stream(settings: dict, index: int, incline: InclinedPlate, materials=N
     spread = require_nonnegative(f"{field}.velocity_spread", get("velocity_spread", 0.0))
     seed = _integer(f"{field}.seed", get("seed", 0), minimum=0)
     tries = _integer(f"{field}.max_tries", get("max_tries", 100), minimum=1)
+    spin = require_nonnegative(
+        f"{field}.angular_velocity_spread", get("angular_velocity_spread", 0.0)
+    )
     return StreamSettings(
         field, name.strip(), rate, start, stop, fraction, coal, gangue, radius, dist, params,
-        area, height, velocity, spread, seed, tries,
+        area, height, velocity, spread, seed, tries, spin,
     )  # fmt: skip
 
 
@@ -334,13 +344,15 @@ class _Draws:
     radii: np.ndarray
     velocities: np.ndarray
     position_rng: np.random.Generator
+    spins: np.ndarray
 
 
 def _draw(s: StreamSettings) -> _Draws:
+    # the sixth child leaves the first five, and so every other quantity, as they were
     gens = [
-        np.random.Generator(np.random.PCG64(c)) for c in np.random.SeedSequence(s.seed).spawn(5)
+        np.random.Generator(np.random.PCG64(c)) for c in np.random.SeedSequence(s.seed).spawn(6)
     ]
-    arrivals, labels, sizes, speeds, places = gens
+    arrivals, labels, sizes, speeds, places, turns = gens
     times, t = [], s.start
     while True:  # Poisson process: exponential gaps, drawn in blocks
         gaps = -np.log1p(-arrivals.random(256)) / s.rate
@@ -354,7 +366,10 @@ def _draw(s: StreamSettings) -> _Draws:
     radii = _radii(s, sizes.random(n))
     normal = ndtri(speeds.random((n, 3)))
     velocities = np.asarray(s.velocity) + s.velocity_spread * normal
-    return _Draws(s, np.array(times), gangue, radii, velocities, places)
+    spins = np.zeros((n, 3))
+    if s.angular_velocity_spread > 0.0:
+        spins = s.angular_velocity_spread * ndtri(turns.random((n, 3)))
+    return _Draws(s, np.array(times), gangue, radii, velocities, places, spins)
 
 
 def generate_particles(streams, incline: InclinedPlate, materials=None) -> list:
@@ -435,4 +450,5 @@ def _place(d: _Draws, k: int, t: float, zone: _Zone) -> Particle:
     return Particle(
         f"{s.name}-{k + 1}", s.name, "gangue" if gangue else "coal", material, r, mass,
         float(t), tuple(float(c) for c in x), tuple(float(c) for c in v),
+        tuple(float(c) for c in d.spins[k]),
     )  # fmt: skip

@@ -97,6 +97,10 @@ class ModalReplay:
         """(q, q', q'') of every mode at ``times`` (s), each (n_modes, len(times)); exact."""
         return self._replay(times, None)
 
+    def modal_coordinates(self, times) -> np.ndarray:
+        """(n_modes, len(times)) modal coordinates q (sqrt(kg) m) at ``times`` (s); exact."""
+        return self.modal_sample(times)[0]
+
     def _replay(self, times, points):
         t = np.atleast_1d(np.asarray(times, dtype=float))
         order = np.argsort(t, kind="stable")

@@ -55,9 +55,12 @@ def plate_response(
     node_time_ulps: float = NODE_TIME_ULPS,
     batch_nodes: int = BATCH_NODES,
     max_bytes: float = MAX_BYTES,
+    modal: bool = False,
 ) -> dict:
     """Plate deflection "w" (m, + up), velocity "v" (m/s) and acceleration "a" (m/s^2) at
-    ``points`` under ``loads``, each (p, len(times)).
+    ``points`` under ``loads``, each (p, len(times)); with ``modal`` the kept modes'
+    coordinates q, q', q'' instead (sqrt(kg) m and its rates, each (n_modes, len(times));
+    ``points`` and ``quasi_static`` are then ignored).
 
     Parameters
     ----------
@@ -88,19 +91,24 @@ def plate_response(
     batch_nodes, max_bytes : int, float
         Load nodes per batch of mode shapes; memory bound (bytes, WorkLimitError above it).
     """
-    pts = check_points(basis.plate, points, "points")
-    t0, dt, n_samples = uniform_times(times)
     omega = np.ascontiguousarray(basis.omega, dtype=float)
+    if modal:  # the identity as the "shapes at the points": the outputs are q, q', q''
+        pts, phi_pts, quasi_static = None, np.eye(omega.shape[0]), False
+    else:
+        pts = check_points(basis.plate, points, "points")
+        phi_pts = np.ascontiguousarray(basis.deflection(pts), dtype=float)
+    t0, dt, n_samples = uniform_times(times)
     zeta = _zeta(zeta, omega.shape[0])
     xyr = _load_points(basis, loads, load_radius)
     _check_batching(node_time_ulps, batch_nodes)
-    _check_memory(len(pts), n_samples, loads, omega.shape[0], batch_nodes, max_bytes)
+    _check_memory(len(phi_pts), n_samples, loads, omega.shape[0], batch_nodes, max_bytes)
     nodes = node_jumps(loads, t0, dt, n_samples)
-    phi_pts = np.ascontiguousarray(basis.deflection(pts), dtype=float)
-    out = empty_outputs(len(pts), n_samples)
+    out = empty_outputs(len(phi_pts), n_samples)
     grid = (t0, dt, n_samples)
     batching = (int(batch_nodes), float(node_time_ulps))
-    g, h, seen = _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, grid, batching, out)
+    what = "modal coordinates" if modal else "plate response at the sensors"
+    g, h, seen = _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, grid, batching, out,
+                            what)  # fmt: skip
     r = np.zeros_like(g)
     if quasi_static:
         r = _residual(basis, xyr, pts, seen, g)
@@ -171,10 +179,11 @@ def node_jumps(loads, t0: float, dt: float, n_samples: int) -> dict:
     return {"df": df, "ds": ds, "target": target, "last": last}
 
 
-def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, out):
+def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, out, what):
     """Run ``march`` over all samples, the nodes in batches of ``batch_nodes`` (their pieces'
     mode shapes evaluated per batch); times = (t0 s, dt s, N), batching = (batch_nodes,
-    node_time_ulps). Returns G, H (pieces, p) and which pieces were seen."""
+    node_time_ulps); ``what`` names the progress. Returns G, H (pieces, p) and which pieces
+    were seen."""
     n_pieces = xyr.shape[0]
     t0, dt, n_samples = times
     batch_nodes, ulps = batching
@@ -193,7 +202,7 @@ def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, 
     order = np.argsort(nodes["target"], kind="stable")
     n_act = int(np.searchsorted(nodes["target"], n_samples, sorter=order))
     done = -1
-    with task("plate response at the sensors", total=max(n_act, 1), unit="load nodes") as bar:
+    with task(what, total=max(n_act, 1), unit="load nodes") as bar:
         start = 0
         while start < n_act:
             stop = min(start + batch_nodes, n_act)
@@ -360,6 +369,15 @@ class LoadResponse:
         for x, y, t0, t1, f in dead:
             loads.add_dead_load(x, y, t0, t1, f)
         return cls(basis, zeta, loads, quasi_static)
+
+    def modal_coordinates(self, times) -> np.ndarray:
+        """(n_modes, len(times)) modal coordinates q (sqrt(kg) m) at uniform ``times`` (s),
+        exact for the recorded loads (``plate_response`` with ``modal``)."""
+        t = np.asarray(times, dtype=float)
+        if t.size == 1:  # one time: a grid of two, the second one step later
+            return self.modal_coordinates(np.array([t[0], t[0] + 1e-3]))[:, :1]
+        response = plate_response(self.basis, self.zeta, self.loads, None, t, modal=True)
+        return response["w"]
 
     def sensor_outputs(self, sensors, duration: float) -> dict:
         """name -> ``tailbeam.signals.sensor.SensorOutput`` of each ``SensorSpec`` of

@@ -37,6 +37,10 @@ REFERENCE_RTOL = 1e-10
 # (examples/small_stream.toml: 1082 steps); it grows ~N^2 (all pairs).
 REFERENCE_STEP_SECONDS = 3e-3
 REFERENCE_STEP_PARTICLES = 12
+FRICTION_REFUSAL = (
+    "contact.friction: '{name}' models frictionless contacts only; friction and rotation run "
+    f"on --solver stream-reference (rigid plate, at most {REFERENCE_MAX_PARTICLES} particles)"
+)
 
 
 class Stream(Solver):
@@ -48,6 +52,11 @@ class Stream(Solver):
     label = "fast stream solver"
     max_particles = MAX_PARTICLES
     rtol, max_steps = DEFAULT_RTOL, DEFAULT_MAX_STEPS
+
+    def refusal(self, scene) -> str | None:
+        if scene.friction is None:
+            return None
+        return FRICTION_REFUSAL.format(name=self.name)
 
     def estimate(self, n_particles: int, max_steps: int) -> tuple[float, float]:
         """Upper-bound-style estimates (bytes, s): per particle ~30 contact records and force
@@ -76,6 +85,7 @@ class Stream(Solver):
                 scene.particles, scene.incline, scene.duration, laws=scene.contacts(),
                 rtol=rtol, max_steps=max_steps, progress=advance, setup=plate,
                 sensors=scene.sensors, info={"solver_choice": self.name}, streams=scene.streams,
+                frames=options.frames,
             )  # fmt: skip
 
     def _announce(self, scene, rtol, max_steps):
@@ -93,6 +103,7 @@ class StreamReference(Stream):
 
     name = "stream-reference"
     label = "stream reference (scipy DOP853, all pairs watched)"
+    frames = False  # it keeps its steps, not states at chosen times
     max_particles = REFERENCE_MAX_PARTICLES
     rtol, max_steps = REFERENCE_RTOL, REFERENCE_MAX_STEPS
 
@@ -124,14 +135,14 @@ class StreamReference(Stream):
             return simulate_reference(
                 scene.particles, scene.incline, scene.duration, laws=scene.contacts(),
                 rtol=rtol, max_steps=max_steps, progress=advance,
-                info={"solver_choice": self.name},
+                info={"solver_choice": self.name}, friction=scene.friction,
             )  # fmt: skip
 
 
 def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
                     rtol: float = DEFAULT_RTOL, max_steps: int = DEFAULT_MAX_STEPS,
                     progress=True, rest_speed: float = DEFAULT_REST_SPEED, setup=None,
-                    sensors=(), info=None, streams=()) -> Result:  # fmt: skip
+                    sensors=(), info=None, streams=(), frames=()) -> Result:  # fmt: skip
     """The fast stream solver on ``particles`` (``tailbeam.streams.generator.Particle``).
 
     Parameters
@@ -156,11 +167,13 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         The streams ``particles`` come from: what each delivered goes to ``info["streams"]``
         (``tailbeam.streams.delivery``) and is said on stderr; the largest release delay (s)
         of any particle to ``stats["release_delay_max"]``.
+    frames : sequence of float
+        Frame times (s): every ball's state there goes to the result's ``frames``.
     """
     run = solve_stream(
         particles, incline, duration, rtol=rtol, rest_speed=rest_speed, max_work=max_steps,
         progress=progress, plate=_stream_plate(setup),
-        contacts=contact_table(particles, laws, incline.plate.material),
+        contacts=contact_table(particles, laws, incline.plate.material), frames=frames,
     )  # fmt: skip
     number_contacts(run.contacts, run.leaves, incline)
     flow = _delivered(streams, particles, run, duration)
@@ -170,7 +183,7 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         leaves=run.leaves, status=run.status, message=run.message, stats=run.stats,
         info={"solver": "fast stream solver (event-driven, active-set DOP853)",
               **(setup.info() if setup else {}), **flow, **(info or {})},
-        sensors=tuple(sensors), plate=_response(setup, run),
+        sensors=tuple(sensors), plate=_response(setup, run), frames=run.frames,
     )  # fmt: skip
 
 
@@ -189,14 +202,16 @@ def _delivered(streams, particles, run, duration) -> dict:
 
 def simulate_reference(
     particles, incline, duration, *, laws, rtol=REFERENCE_RTOL, max_steps=REFERENCE_MAX_STEPS,
-    progress=None, info=None,
+    progress=None, info=None, friction=None,
 ) -> Result:  # fmt: skip
     """The slow reference (``simulate_stream_reference``) on ``particles``, as a Result;
-    arguments as ``simulate_stream``'s (``info``: more entries for ``Result.info``)."""
+    arguments as ``simulate_stream``'s (``info``: more entries for ``Result.info``;
+    ``friction``: a ``FrictionModel`` or None)."""
     ref = simulate_stream_reference(
         [p.ball() for p in particles], incline, duration,
         contacts=contact_table(particles, laws, incline.plate.material), rtol=rtol,
         max_steps=max_steps, release_times=[p.t_release for p in particles], progress=progress,
+        friction=friction,
     )  # fmt: skip
     stats = {"n_steps": ref.steps, "n_contacts": len(ref.contacts), "n_leaves": len(ref.leaves)}
     number_contacts(ref.contacts, ref.leaves, incline)
@@ -205,6 +220,7 @@ def simulate_reference(
         impacts=sorted(ref.contacts, key=lambda r: (r.t_start, r.ball)), events=ref.events,
         leaves=ref.leaves, message="reached the end of the simulation", stats=stats,
         info={**ref.info, **(info or {})},
+        angular_velocity={} if friction is None else ref.angular_velocity,
     )  # fmt: skip
 
 

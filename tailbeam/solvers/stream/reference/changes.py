@@ -9,6 +9,7 @@ from tailbeam.physics.contact_law import clamp_indicator
 from tailbeam.physics.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES
 from tailbeam.results.records import End, EventKind
+from tailbeam.solvers.stream.reference.friction import slip_speed
 
 
 class SceneChanges:
@@ -43,6 +44,14 @@ class SceneChanges:
         self.mass = mass
         self.rtol = rtol
         self.waiting = list(waiting)
+        self.radius = np.array([b.radius for b in balls], dtype=float)
+
+    def slip(self, pair, y) -> float:
+        """The slip speed (m/s) of ``pair`` at state vector y (nan without friction)."""
+        x, v = self.layout.split(y)
+        modes = self.layout.modes(y)
+        modes = None if modes is None else tuple(a[None] for a in modes)
+        return slip_speed(pair, self.kinematics, self.radius, x, v, self.layout.spins(y), modes)
 
     def next_stop(self, duration):
         """Where the integration must stop next (s): the next release time or ``duration``."""
@@ -64,7 +73,7 @@ class SceneChanges:
             self.log.open(p, t, kin, x[li[0]], v, li[0], lj[0])
             return y, first_contact_step(p, self.mass, self.rtol, kin.rate[0])
         if kind == EventKind.CONTACT_END:
-            self.log.close(p, t, kin, v, li[0], lj[0], End.SEPARATED)
+            self.log.close(p, t, kin, v, li[0], lj[0], End.SEPARATED, self.slip(p, y))
             return y, None
         if kind == EventKind.FULL_DAMPING:
             p.ramp = not p.ramp
@@ -78,29 +87,31 @@ class SceneChanges:
         """Ball ``ball`` (index) leaves over ``edge`` at time t (s): its contacts end, it and
         its pairs are dropped. Returns the state vector without it."""
         x, v = self.layout.split(y)
-        modes = self.layout.modes(y)
+        modes, w = self.layout.modes(y), self.layout.spins(y)
         for p in self.pairs.drop_ball(ball):
             if p.in_contact:
                 kin, li, lj, _ = self.kinematics.of([p], x, v, modes)
-                self.log.close(p, t, kin, v, li[0], lj[0], End.LEFT)
-        self.log.left(ball, edge, t)
+                self.log.close(p, t, kin, v, li[0], lj[0], End.LEFT, self.slip(p, y))
+        self.log.left(ball, edge, t, None if w is None else w[self.layout.active.index(ball)])
         keep = self.layout.remove(ball)
-        return self.layout.join(x[keep], v[keep], modes)
+        return self.layout.join(x[keep], v[keep], modes, None if w is None else w[keep])
 
     def release_due(self, t, y):
         """Add the balls whose release time is t (s), at their given position and velocity,
         with their pairs. Returns the state vector with them."""
         x, v = self.layout.split(y)
-        modes = self.layout.modes(y)
+        modes, w = self.layout.modes(y), self.layout.spins(y)
         new = []
         while self.waiting and self.waiting[0][0] <= t:
             _, i = self.waiting.pop(0)
             self.layout.add(i)
             x = np.vstack([x, self.balls[i].position])
             v = np.vstack([v, self.balls[i].velocity])
+            if w is not None:
+                w = np.vstack([w, self.balls[i].angular_velocity])
             new.extend(self.pairs.add_ball(i, self.layout.active))
             self.log.released(i, t)
-        y = self.layout.join(x, v, modes)
+        y = self.layout.join(x, v, modes, w)
         self.touch(new, t, y)
         return y
 

@@ -23,6 +23,7 @@ class ContactLog:
         self.contacts = []
         self.leaves = []
         self.events = []
+        self.spin_at_leave = {}  # name -> angular velocity (3,) rad/s when it left (friction)
 
     def log(self, t, kind, pair) -> None:
         """Log event ``kind`` (``EventKind``) of ``pair`` at time t (s)."""
@@ -60,21 +61,24 @@ class ContactLog:
         self.contacts.extend(records)
         self.log(t, EventKind.CONTACT_START, pair)
 
-    def close(self, pair, t, kin, v, li, lj, end) -> None:
+    def close(self, pair, t, kin, v, li, lj, end, slip=float("nan")) -> None:
         """End the contact of ``pair`` at time t (s) as ``end`` (an ``End``); arguments as
-        ``open``."""
+        ``open``; ``slip``: the slip speed at the end (m/s, with friction)."""
         n = kin.normal[0]
         outs = [float(v[li] @ n)] + ([float(-v[lj] @ n)] if pair.j >= 0 else [])
         # approach speeds of a plate row: the ball's (as v_in, v_out), also on the modal plate
         out = -float(kin.rate[0]) if pair.j >= 0 or self.plate is None else outs[0]
         for rec, v_out in zip(pair.records, outs, strict=True):
             rec.t_end, rec.v_out, rec.approach_out, rec.end = t, v_out, out, end
-        pair.stop()
+        pair.stop(slip)
         self.log(t, EventKind.CONTACT_END, pair)
 
-    def left(self, ball, edge, t) -> None:
-        """Record that ``ball`` (index) left over ``edge`` (``x+``, ...) at time t (s)."""
+    def left(self, ball, edge, t, spin=None) -> None:
+        """Record that ``ball`` (index) left over ``edge`` (``x+``, ...) at time t (s), with
+        angular velocity ``spin`` (3,) rad/s (with friction; else None)."""
         name = self.balls[ball].name
+        if spin is not None:
+            self.spin_at_leave[name] = spin.copy()
         self.leaves.append(LeaveEvent(name, t, edge))
         self.events.append(Event(t, name, EventKind.LEAVE, edge))
 

@@ -98,15 +98,29 @@ class Kinematics:
 
     def modal(self, pairs, x, v, modes):
         """``of`` on the modal plate: the plate pairs' penetration and rate against the
-        deflected plate; also returns their slope (P', 2) and shapes (P', m), flattened over
-        the leading axes as the kinematics."""
+        deflected plate; also returns their slope (P', 2), shapes (P', m) and the shapes'
+        gradients (P', m, 2), flattened over the leading axes as the kinematics."""
         ix = pairs if isinstance(pairs, PairIndex) else self.index(pairs)
         kin, li, lj, is_plate, xi, vi, rsum = self.rigid(ix, x, v)
-        gap, rate, slope, phi = self.plate.contact_geometry(xi, vi, is_plate, ix.frozen_phi, modes)
+        gap, rate, slope, phi, grad = self.plate.contact_geometry(
+            xi, vi, is_plate, ix.frozen_phi, modes
+        )
         flat = np.broadcast_to(is_plate, rsum.shape).reshape(-1)
         kin = replace(
             kin,
             penetration=np.where(flat, (rsum + gap).reshape(-1), kin.penetration),
             rate=np.where(flat, rate.reshape(-1), kin.rate),
         )
-        return kin, li, lj, is_plate, slope.reshape(-1, 2), phi.reshape(-1, self.plate.n_modes)
+        m = self.plate.n_modes
+        return (kin, li, lj, is_plate, slope.reshape(-1, 2), phi.reshape(-1, m),
+                grad.reshape(-1, m, 2))  # fmt: skip
+
+    def surface_velocity(self, grad, qd, pairs: int):
+        """In-plane velocity (P', 3) of the plate's top surface under each pair's point
+        (m/s; z left 0): -(h/2) grad phi . q'. ``grad`` (P', m, 2) as ``modal`` returns it
+        for ``pairs`` pairs per state, qd (..., m) the modal rates of those states."""
+        rows = np.repeat(np.reshape(qd, (-1, self.plate.n_modes)), pairs, axis=0)
+        out = np.zeros((grad.shape[0], 3))
+        half = 0.5 * self.plate.basis.plate.thickness
+        out[:, :2] = -half * np.einsum("rmk,rm->rk", grad, rows)
+        return out

@@ -26,14 +26,18 @@ class Integrator:
         The modal plate (its modes' tolerances), or None for the rigid plate.
     rtol : float
         DOP853's relative tolerance; atol = rtol x 1 mm on positions, rtol x 1 m/s on
-        velocities (and ``ReferencePlate.atol`` on the modes).
+        velocities, rtol x (1 m/s) / r on a ball's angular velocity (with friction; r its
+        radius) (and ``ReferencePlate.atol`` on the modes).
+    radius : ndarray, optional
+        Radius of every ball (m), for the angular velocities' tolerances.
     """
 
-    def __init__(self, dynamics, layout, plate, rtol):
+    def __init__(self, dynamics, layout, plate, rtol, radius=None):
         self.dynamics = dynamics
         self.layout = layout
         self.plate = plate
         self.rtol = rtol
+        self.radius = radius
         # (see Dynamics._modal_rhs: a modal trial step may overflow, DOP853 then rejects it)
         self.trial_errors = {} if plate is None else dict(over="ignore", invalid="ignore")
 
@@ -42,6 +46,9 @@ class Integrator:
         None: DOP853's choice) and largest step ``max_step`` (s)."""
         n = len(self.layout.active)
         atol = self.rtol * np.concatenate([np.full(3 * n, 1e-3), np.ones(3 * n)])
+        if self.layout.spin:
+            spin = np.repeat(1.0 / self.radius[self.layout.active], 3)
+            atol = np.concatenate([atol, self.rtol * spin])
         if self.plate is not None:
             atol = np.concatenate([atol, self.plate.atol(self.rtol)])
         if h0 is not None:

@@ -32,6 +32,15 @@ class Pair:
         The open contact's largest force (N), its time (s) and largest penetration (m).
     phi0 : ndarray or None
         Mode shapes (1/sqrt(kg)) kept by a frozen plate contact (modal plate), else None.
+    friction : FrictionSettings or None
+        The pair's friction (``tailbeam.physics.friction``); None: frictionless.
+    share : float
+        r_i / (r_i + r_j): where the common contact point lies on the line of centres, as a
+        fraction of the centres' distance from ball i (1 for the plate: its surface).
+    normal_impulse : float
+        The open contact's integral of the normal force (N s).
+    tangential_impulse : ndarray
+        The open contact's integral of the tangential force on ball i (3,) (N s).
     """
 
     i: int
@@ -46,6 +55,10 @@ class Pair:
     t_peak: float = math.nan
     pen: float = 0.0
     phi0: np.ndarray | None = None
+    friction: object = None
+    share: float = 1.0
+    normal_impulse: float = 0.0
+    tangential_impulse: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     @property
     def kinked(self) -> bool:
@@ -59,16 +72,26 @@ class Pair:
         self.in_contact, self.ramp, self.clamped = True, True, False
         self.peak, self.t_peak, self.pen = 0.0, math.nan, max(0.0, penetration)
         self.records, self.phi0 = records, phi0
+        self.normal_impulse, self.tangential_impulse = 0.0, np.zeros(3)
 
-    def stop(self) -> None:
-        """Close the contact: its peaks go into its records, which it then lets go."""
-        self.write_peaks()
+    def stop(self, slip=math.nan) -> None:
+        """Close the contact: its peaks go into its records, which it then lets go. ``slip``:
+        the slip speed at the end (m/s; ``write_peaks``)."""
+        self.write_peaks(slip)
         self.in_contact, self.records, self.phi0 = False, [], None
 
-    def write_peaks(self) -> None:
-        """Copy the peak force, its time and the largest penetration into the records."""
+    def write_peaks(self, slip=math.nan) -> None:
+        """Copy the peak force, its time, the largest penetration and the impulses into the
+        records; with friction, how the contact ended tangentially: ``sticking`` if the slip
+        speed ``slip`` (m/s) is below the stiction velocity, else ``sliding``."""
+        tangential = float(np.linalg.norm(self.tangential_impulse))
+        end = "frictionless"
+        if self.friction is not None:
+            end = "sticking" if slip < self.friction.stiction_velocity else "sliding"
         for rec in self.records:
             rec.peak_force, rec.t_peak, rec.max_penetration = self.peak, self.t_peak, self.pen
+            rec.normal_impulse, rec.tangential_impulse = self.normal_impulse, tangential
+            rec.tangential_end = end
 
 
 class PairSet:
@@ -80,11 +103,17 @@ class PairSet:
         The scene's balls (their radii, m).
     table : ContactTable
         The laws of every pair of the scene.
+    friction : FrictionModel or None
+        The scene's friction (None: frictionless).
+    plate_material : str
+        The plate's material name (the friction of ball-plate pairs).
     """
 
-    def __init__(self, balls, table):
+    def __init__(self, balls, table, friction=None, plate_material=""):
         self.balls = balls
         self.table = table
+        self.friction = friction
+        self.plate_material = plate_material
         self.pairs = {}
 
     def __getitem__(self, key) -> Pair:
@@ -105,14 +134,29 @@ class PairSet:
         (indices) that has none yet; returns the pairs of ball i with those."""
         a, made = self.balls[i], []
         law = self.table.law(i, PLATE)
-        made.append(self.pairs.setdefault((i, -1), Pair(i, -1, law, a.radius)))
+        plate = Pair(i, -1, law, a.radius, friction=self._friction(a, self.plate_material))
+        made.append(self.pairs.setdefault((i, -1), plate))
         for j in present:
             if j != i:
                 lo, hi = min(i, j), max(i, j)
                 b, c = self.balls[lo], self.balls[hi]
-                pair = Pair(lo, hi, self.table.law(lo, hi), b.radius + c.radius)
-                made.append(self.pairs.setdefault((lo, hi), pair))
+                rsum = b.radius + c.radius
+                pair = Pair(
+                    lo,
+                    hi,
+                    self.table.law(lo, hi),
+                    rsum,
+                    friction=self._friction(b, c.material.name),
+                    share=b.radius / rsum,
+                )
+                made.append(self.pairs.setdefault((lo, hi), pair))  # fmt: skip
         return made
+
+    def _friction(self, ball, other: str):
+        """The friction of ``ball`` against material ``other`` (None: frictionless)."""
+        if self.friction is None:
+            return None
+        return self.friction.between(ball.material.name, other)
 
     def drop_ball(self, ball: int) -> list:
         """Remove and return the pairs of ``ball``, in creation order."""

@@ -27,6 +27,14 @@ Mode shapes (``shapes``):
   slope term (the fast solver's contact model: ``tailbeam.solvers.stream.active.compiled.pairs``);
   before a touch the gap is exact. Comparing both variants measures what freezing costs.
 
+Friction (``friction=`` of the reference, exact shapes only). The friction force F_t on a ball
+acts, reversed, on the plate's top surface, h/2 above its mid-surface, whose in-plane
+displacement is -(h/2) grad w (Kirchhoff): the modes feel the generalised force
+(h/2) F_t . grad phi, and the slip is measured against the surface's in-plane velocity
+-(h/2) grad phi . q'. The plate then takes exactly the power the ball gives up less what
+friction dissipates (F_t . slip), so with c = 0 and undamped modes energy + dissipated is
+conserved (the check).
+
 grad phi is a central difference of the basis (step ``GRADIENT_STEP``: relative error
 ~(k h)^2 / 6 < 1e-7 of the slope for wavenumbers k < 100 /m, itself ~1e-5 of the force).
 """
@@ -137,7 +145,8 @@ class ReferencePlate:
         xi, vi: (..., P, 3) centre and velocity of each pair's ball i; is_plate (P,);
         frozen_phi: (P, m) shapes kept by frozen contacts (NaN rows: evaluate exactly);
         modes: (q, q') each (..., m). Returns arrays (..., P) delta - r (m, i.e. w - z),
-        rate (m/s), (..., P, 2) slope and (..., P, m) shapes, zero where not is_plate.
+        rate (m/s), (..., P, 2) slope, (..., P, m) shapes and (..., P, m, 2) their gradients
+        (1/(m sqrt(kg)); zero for frozen shapes), zero where not is_plate.
         """
         q, qd = modes
         lead, p, m = xi.shape[:-2], xi.shape[-2], self.n_modes
@@ -155,4 +164,4 @@ class ReferencePlate:
         wd = np.einsum("...pm,...m->...p", phi, qd)
         slope = np.einsum("...pmk,...m->...pk", grad, q)
         rate = -vi[..., 2] + wd + np.einsum("...pk,...pk->...p", slope, vi[..., :2])
-        return w - xi[..., 2], rate, slope, phi
+        return w - xi[..., 2], rate, slope, phi, grad

@@ -1,8 +1,9 @@
 """Slow, independent reference for streams: all balls and the inclined plate together, the
 plate rigid or modal (two-way, ``plate=ReferencePlate(...)``, see below).
 
-One ODE for every ball (3-D translation, frictionless, normal forces only, no rotation),
-integrated by scipy's DOP853 (the method of ``solve_ivp(method="DOP853")``, driven step by
+One ODE for every ball (3-D translation; with ``friction`` also its rotation, the tangential
+forces and rolling resistance of ``tailbeam.solvers.stream.reference.friction``), integrated
+by scipy's DOP853 (the method of ``solve_ivp(method="DOP853")``, driven step by
 step through its ``OdeSolver`` class so that every step can be checked for contacts; rtol
 1e-12 by default). Every pair is watched (O(N^2): this is the slow reference):
 
@@ -28,6 +29,16 @@ The parts, each given the others it uses when it is made (``_simulate`` wires th
 * ``contacts.ContactLog``: the records written out (contacts, leaves, the event log);
 * ``steps.StepSeries``: what an accepted step records (peaks, energy, states);
 * ``loop.StepLoop``: drives DOP853 (``loop.Integrator``) from event to event.
+
+Friction (``friction=FrictionModel``, rigid plate). The state gains every ball's angular
+velocity (moment of inertia 2/5 m r^2). The regularised Adams law is smooth (C^1 in the slip
+velocity), so it needs no event of its own: DOP853 resolves its stiffness by short steps.
+That is the honest cost of the slow truth: with a contact held at slip speeds below v_s the
+step is bounded by stability to ~3 / lambda, lambda ~ mu_s |F_n| / (m_eff v_s) (about 1e-4 s
+for a ball resting on the plate with v_s = 1e-3 m/s, and shorter during impacts, where F_n is
+thousands of times the weight); the run's step budget ``max_steps`` bounds it. Impulses and
+friction's dissipated energy are integrated on every accepted step (``steps``); the energy
+series includes the rotational energy 1/2 I w^2, and energy + dissipated never grows.
 
 Modal plate (``tailbeam.solvers.stream.reference.plate``: the model, exact or frozen mode
 shapes). The state gains the modal coordinates [q | q'] after the balls (atol: deflections to
@@ -55,6 +66,7 @@ import numpy as np
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.contact_law import HERTZ_EXPONENT
 from tailbeam.physics.contacts import LawOptions, contact_table
+from tailbeam.physics.friction import FrictionModel
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.solvers.stream.reference.changes import SceneChanges
 from tailbeam.solvers.stream.reference.contacts import ContactLog
@@ -101,6 +113,15 @@ class StreamReferenceResult:
     plate_states : list of tuple
         Modal plate: (q, q') per entry of ``times`` (m sqrt(kg), m sqrt(kg) / s); empty on
         the rigid plate.
+    spins : list of ndarray
+        With friction: the present balls' angular velocities (n, 3) (rad/s) per entry of
+        ``times`` (the balls of ``states``); empty without.
+    dissipated : ndarray
+        With friction: the energy friction and rolling resistance dissipated since the start
+        (J) at ``times``; empty without.
+    angular_velocity : dict
+        Every ball's name -> its angular velocity (3,) (rad/s) when it left or at the end (a
+        ball never released: its initial one).
     """
 
     names: tuple
@@ -114,6 +135,9 @@ class StreamReferenceResult:
     steps: int
     info: dict
     plate_states: list = field(default_factory=list)
+    spins: list = field(default_factory=list)
+    dissipated: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    angular_velocity: dict = field(default_factory=dict)
 
     def contacts_of(self, ball: str) -> list:
         """The contact records of the ball named ``ball``."""
@@ -135,6 +159,7 @@ def simulate_stream_reference(
     progress=None,
     plate: ReferencePlate | None = None,
     contacts=None,
+    friction=None,
 ) -> StreamReferenceResult:
     """Integrate a stream of balls on an inclined plate, every pair watched (module
     docstring).
@@ -166,6 +191,9 @@ def simulate_stream_reference(
         rigid plate.
     contacts : ContactTable, optional
         The balls' contact table; its settings then replace the IMPACT parameters above.
+    friction : FrictionModel, optional
+        Friction and rolling resistance of every contact (``tailbeam.physics.friction``;
+        rigid plate only); None: frictionless, the balls' angular velocities never change.
 
     Returns
     -------
@@ -182,18 +210,29 @@ def simulate_stream_reference(
             raise InputError("plate", "must be a ReferencePlate (a modal basis and its damping)")
         plate.check_size(incline)
         _check_modal_work(plate, duration, max_steps)
+        if friction is not None and plate.frozen:
+            raise InputError(
+                "contact.friction", "friction on the stream reference's modal plate needs "
+                'exact mode shapes (ReferencePlate(..., shapes="exact"))'
+            )  # fmt: skip
+    if friction is not None and not isinstance(friction, FrictionModel):
+        raise InputError("contact.friction", "must be a FrictionModel (or None: frictionless)")
     _check_balls(balls, incline)
     table = contact_table(balls, options, incline.plate.material)  # the pairs' laws
-    return _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, progress)
+    run = (balls, incline, table, release, plate, duration, rtol, max_steps, progress)
+    return _simulate(*run, friction)
 
 
-def _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, progress):
+def _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, progress,
+              friction=None):  # fmt: skip
     """Wire the parts (module docstring), run them and collect the result."""
     mass = np.array([b.mass for b in balls])
+    radius = np.array([b.radius for b in balls])
     present = [i for i in range(len(balls)) if release[i] <= 0.0]
     waiting = sorted((float(release[i]), i) for i in range(len(balls)) if release[i] > 0)
-    layout = StateLayout(len(balls), None if plate is None else plate.n_modes, present)
-    pairs = PairSet(balls, table)
+    n_modes = None if plate is None else plate.n_modes
+    layout = StateLayout(len(balls), n_modes, present, spin=friction is not None)
+    pairs = PairSet(balls, table, friction, incline.plate.material.name)
     for i in present:
         pairs.add_ball(i, present)
     kinematics = Kinematics(layout, plate)
@@ -201,14 +240,15 @@ def _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, 
     changes = SceneChanges(layout, pairs, kinematics, log, balls, mass, rtol, waiting)
     series = StepSeries(layout, pairs, kinematics, balls, mass, incline, plate)
     search = EventSearch(pairs, layout, kinematics, incline, plate)
-    dynamics = Dynamics(layout, kinematics, pairs, mass, incline.gravity_vector, plate)
-    integrator = Integrator(dynamics, layout, plate, rtol)
+    dynamics = Dynamics(layout, kinematics, pairs, mass, incline.gravity_vector, plate, radius)
+    integrator = Integrator(dynamics, layout, plate, rtol, radius)
     loop = StepLoop(integrator, search, changes, series, max_steps, progress)
-    y = _initial_state(balls, present, plate)
+    y = _initial_state(balls, present, plate, layout.spin)
     changes.touch(list(pairs.values()), 0.0, y)
     loop.run(0.0, y, duration)
+    y = loop.solver.y
     for p in pairs.values():  # the contacts still in progress
-        p.write_peaks()
+        p.write_peaks(changes.slip(p, y) if p.in_contact else float("nan"))
     info = {
         "solver": f"stream reference: scipy DOP853 rtol={rtol:g}, restarted at kinks",
         "plate": "rigid"
@@ -216,20 +256,37 @@ def _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, 
         else f"modal, two-way: {plate.n_modes} modes, {plate.shapes} shapes",
         "duration": duration,
     }
+    if friction is not None:
+        info["friction"] = "Adams CONTACT friction and rolling resistance, rotation"
     return StreamReferenceResult(
         tuple(b.name for b in balls), mass, log.contacts, log.leaves, log.events,
         np.array(series.times), np.array(series.energy), series.states, loop.steps, info,
-        series.plate_states,
+        series.plate_states, series.spins, np.array(series.dissipated),
+        _final_spins(balls, layout, y, log),
     )  # fmt: skip
 
 
-def _initial_state(balls, present, plate):
-    """The state vector at t = 0: the present balls' positions and velocities, the plate at
-    rest."""
+def _final_spins(balls, layout, y, log) -> dict:
+    """Every ball's angular velocity (rad/s) when it left, at the end (present) or as given
+    (never released, or frictionless: it never changes)."""
+    out = {b.name: np.array(b.angular_velocity, dtype=float) for b in balls}
+    out.update(log.spin_at_leave)
+    w = layout.spins(y)
+    if w is not None:
+        out.update({balls[i].name: w[q].copy() for q, i in enumerate(layout.active)})
+    return out
+
+
+def _initial_state(balls, present, plate, spin=False):
+    """The state vector at t = 0: the present balls' positions and velocities (and with
+    ``spin`` their angular velocities), the plate at rest."""
     pos = np.array([balls[i].position for i in present], dtype=float).reshape(-1, 3)
     vel = np.array([balls[i].velocity for i in present], dtype=float).reshape(-1, 3)
+    w = np.array([balls[i].angular_velocity for i in present], dtype=float).reshape(-1, 3)
     m = 0 if plate is None else plate.n_modes
-    return StateLayout.join(pos, vel, (np.zeros(m), np.zeros(m)) if m else None)
+    return StateLayout.join(
+        pos, vel, (np.zeros(m), np.zeros(m)) if m else None, w if spin else None
+    )
 
 
 def _check_modal_work(plate, duration, max_steps):
