@@ -20,6 +20,7 @@ from tailbeam.plate.basis import ModalBasis
 from tailbeam.plate.fe.sparse_solve import count_eigenvalues_below, lowest_modes
 from tailbeam.plate.solid.factor import factorize
 from tailbeam.plate.solid.model import StructureModel
+from tailbeam.plate.solid.surface import cyclic_corners
 from tailbeam.progress import task
 
 THEORY = "solid"
@@ -40,6 +41,25 @@ class StructureModalBasis(ModalBasis):
         ``field_name`` for a point off the surface."""
         op = self.model.surface_operator(points, directions, field_name)
         return np.asarray(op @ self.mode_vectors)[:, : self.n_modes]
+
+    def vtk_structure(self):
+        """(points (p, 3) m, meshio cell blocks, shapes (p, 3, n) 1/sqrt(kg)): the outer
+        surface (its boundary faces on the mesh's corner nodes) and each mode's displacement
+        at those nodes, for the ParaView series (``tailbeam.io.paraview``)."""
+        mesh = self.model.vmesh.mesh
+        corners = mesh.facets[:, mesh.boundary_facets()]
+        kind = "triangle" if corners.shape[0] == 3 else "quad"
+        if kind == "quad":
+            corners = cyclic_corners(mesh.p, corners).T
+        nodes, local = np.unique(corners, return_inverse=True)
+        probe = self.model.probe()
+        scalar_dofs = probe.scalar.nodal_dofs[0, nodes]  # the value at each corner node
+        shapes = np.empty((len(nodes), 3, self.n_modes))
+        for c, idx in enumerate(probe.indices):
+            rows = self.model.transform[idx[scalar_dofs]]
+            shapes[:, c, :] = np.asarray(rows @ self.mode_vectors)[:, : self.n_modes]
+        cells = [(kind, local.reshape(corners.shape).T.astype(np.int64))]
+        return mesh.p[:, nodes].T.copy(), cells, shapes
 
 
 def _shift(model: StructureModel, fmax_hz: float | None) -> float:
