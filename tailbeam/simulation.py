@@ -12,9 +12,8 @@ each following one protocol (``tailbeam.solvers.base.Solver``):
 - ``"stream-reference"``: the slow independent reference of the stream solver (scipy DOP853,
   every pair watched, at most ``REFERENCE_MAX_PARTICLES`` bodies), on the rigid plate;
 - ``"auto"`` (the default): ``"single-ball"`` where it can run, else ``"stream"``; a scene
-  with friction (``[contact.friction]``): ``"stream-reference"``, the one solver that models
-  it, if it can run the scene (rigid plate, at most ``REFERENCE_MAX_PARTICLES`` bodies), else
-  refused.
+  with friction (``[contact.friction]``): ``"stream"`` on the rigid plate (it and
+  ``"stream-reference"`` model friction there), else refused.
 
 Running one scene through two solvers is how a user checks one against the other.
 """
@@ -99,17 +98,14 @@ def choose_solver(scene, solver: str = "auto", field: str = "solver") -> Solver:
 
 
 def _friction_solver(scene, field: str) -> Solver:
-    """The solver "auto" picks for a scene with friction: the stream reference, or an
-    InputError naming ``contact.friction`` when it cannot run the scene."""
-    method = SOLVERS["stream-reference"]
+    """The solver "auto" picks for a scene with friction: the fast stream solver, or an
+    InputError naming ``contact.friction`` when it cannot run the scene (the modal plate)."""
+    method = SOLVERS["stream"]
     why = method.refusal(scene)
-    n = len(scene.particles)
-    if why is None and n > method.max_particles:
-        why = f"{n} particles, above its limit of {method.max_particles}"
     if why:
         raise InputError(
-            "contact.friction", "only the stream reference models friction and it cannot run "
-            f"this scene ({why}); remove [contact.friction] to run it frictionless"
+            "contact.friction", "the solvers that model friction cannot run this scene "
+            f"({why.removeprefix('contact.friction: ')})"
         )  # fmt: skip
     return method
 

@@ -87,17 +87,20 @@ def test_bad_value_on_the_command_line_is_one_line_and_exit_2(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def test_solvers_without_friction_refuse_it_and_auto_picks_the_reference():
+def test_single_ball_refuses_friction_and_auto_picks_the_fast_stream_solver():
     scene = loads_scene(BASE + FRICTION)
-    for name in ("single-ball", "stream"):
-        with pytest.raises(InputError) as err:
-            choose_solver(scene, name, "--solver")
-        assert "contact.friction" in str(err.value) and "stream-reference" in str(err.value)
-    assert choose_solver(scene).name == "stream-reference"
+    with pytest.raises(InputError) as err:
+        choose_solver(scene, "single-ball", "--solver")
+    assert "contact.friction" in str(err.value) and "stream-reference" in str(err.value)
+    assert choose_solver(scene, "stream", "--solver").name == "stream"
+    assert choose_solver(scene).name == "stream"
     modal = loads_scene(BASE + FRICTION + "[plate]\nmodel = 'modal'\n")
     with pytest.raises(InputError) as err:
         choose_solver(modal)
-    assert err.value.field == "contact.friction"
+    assert err.value.field == "contact.friction" and "rigid" in str(err.value)
+    with pytest.raises(InputError) as err:
+        choose_solver(modal, "stream", "--solver")
+    assert "contact.friction" in str(err.value)
     crowd = (
         BASE
         + FRICTION
@@ -107,9 +110,7 @@ def test_solvers_without_friction_refuse_it_and_auto_picks_the_reference():
             for k in range(20)
         )
     )
-    with pytest.raises(InputError) as err:
-        choose_solver(loads_scene(crowd))
-    assert err.value.field == "contact.friction" and "21 particles" in str(err.value)
+    assert choose_solver(loads_scene(crowd)).name == "stream"  # (no 20-body limit)
 
 
 def test_spins_pass_through_a_frictionless_run_to_particles_csv(tmp_path):
@@ -130,10 +131,11 @@ def test_spins_pass_through_a_frictionless_run_to_particles_csv(tmp_path):
     assert '"wx": "rad/s"' in text and '"tangential_impulse": "N s"' in text
 
 
-def test_the_reference_runs_a_friction_scene_and_writes_the_spin(tmp_path):
+@pytest.mark.parametrize("solver", ["stream-reference", "auto"])
+def test_the_friction_solvers_run_a_friction_scene_and_write_the_spin(tmp_path, solver):
     scene = loads_scene(BASE + FRICTION)
-    result = tailbeam.simulate(scene, progress=False)
-    assert result.info["solver_choice"] == "stream-reference"
+    result = tailbeam.simulate(scene, solver=solver, progress=False)
+    assert result.info["solver_choice"] == ("stream" if solver == "auto" else solver)
     table = result.impacts_table()
     assert table["tangential_impulse"][0] > 0.0
     assert table["tangential_end"][0] in ("sliding", "sticking")

@@ -24,7 +24,7 @@ class SingleBall(Solver):
         if scene.friction is not None:
             return (
                 "contact.friction: 'single-ball' models frictionless contacts only; friction "
-                "and rotation run on --solver stream-reference"
+                "and rotation run on --solver stream or stream-reference (rigid plate)"
             )
         if not scene.needs_stream_solver:
             return None

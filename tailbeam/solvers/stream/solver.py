@@ -38,8 +38,8 @@ REFERENCE_RTOL = 1e-10
 REFERENCE_STEP_SECONDS = 3e-3
 REFERENCE_STEP_PARTICLES = 12
 FRICTION_REFUSAL = (
-    "contact.friction: '{name}' models frictionless contacts only; friction and rotation run "
-    f"on --solver stream-reference (rigid plate, at most {REFERENCE_MAX_PARTICLES} particles)"
+    "contact.friction: '{name}' runs friction and rotation on the rigid plate only "
+    '(plate.model = "rigid"); remove [contact.friction] to run this plate frictionless'
 )
 
 
@@ -54,7 +54,7 @@ class Stream(Solver):
     rtol, max_steps = DEFAULT_RTOL, DEFAULT_MAX_STEPS
 
     def refusal(self, scene) -> str | None:
-        if scene.friction is None:
+        if scene.friction is None or scene.plate_model == "rigid":
             return None
         return FRICTION_REFUSAL.format(name=self.name)
 
@@ -86,6 +86,7 @@ class Stream(Solver):
                 rtol=rtol, max_steps=max_steps, progress=advance, setup=plate,
                 sensors=scene.sensors, info={"solver_choice": self.name}, streams=scene.streams,
                 frames=options.frames,
+                friction=scene.friction,
             )  # fmt: skip
 
     def _announce(self, scene, rtol, max_steps):
@@ -142,7 +143,8 @@ class StreamReference(Stream):
 def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
                     rtol: float = DEFAULT_RTOL, max_steps: int = DEFAULT_MAX_STEPS,
                     progress=True, rest_speed: float = DEFAULT_REST_SPEED, setup=None,
-                    sensors=(), info=None, streams=(), frames=()) -> Result:  # fmt: skip
+                    sensors=(), info=None, streams=(), frames=(),
+                    friction=None) -> Result:  # fmt: skip
     """The fast stream solver on ``particles`` (``tailbeam.streams.generator.Particle``).
 
     Parameters
@@ -169,11 +171,15 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         of any particle to ``stats["release_delay_max"]``.
     frames : sequence of float
         Frame times (s): every ball's state there goes to the result's ``frames``.
+    friction : FrictionModel, optional
+        Friction, rolling resistance and the balls' rotation (rigid plate,
+        ``solve_stream``); None: frictionless.
     """
     run = solve_stream(
         particles, incline, duration, rtol=rtol, rest_speed=rest_speed, max_work=max_steps,
         progress=progress, plate=_stream_plate(setup),
         contacts=contact_table(particles, laws, incline.plate.material), frames=frames,
+        friction=friction,
     )  # fmt: skip
     number_contacts(run.contacts, run.leaves, incline)
     flow = _delivered(streams, particles, run, duration)
@@ -182,8 +188,10 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         impacts=sorted(run.contacts, key=lambda r: (r.t_start, r.ball)), events=run.events,
         leaves=run.leaves, status=run.status, message=run.message, stats=run.stats,
         info={"solver": "fast stream solver (event-driven, active-set DOP853)",
-              **(setup.info() if setup else {}), **flow, **(info or {})},
+              **(setup.info() if setup else {}), **flow, **_friction_info(friction),
+              **(info or {})},
         sensors=tuple(sensors), plate=_response(setup, run), frames=run.frames,
+        angular_velocity=run.angular_velocity,
     )  # fmt: skip
 
 
@@ -222,6 +230,13 @@ def simulate_reference(
         info={**ref.info, **(info or {})},
         angular_velocity={} if friction is None else ref.angular_velocity,
     )  # fmt: skip
+
+
+def _friction_info(friction) -> dict:
+    """The Result.info entry of a run with friction (none without)."""
+    if friction is None:
+        return {}
+    return {"friction": "Adams CONTACT friction and rolling resistance, rotation"}
 
 
 def _setting(value, default):

@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from tailbeam.physics.contact_law import LAW_C, LAW_COLUMNS, LAW_D
+from tailbeam.solvers.stream.active.compiled.friction import IMP_COLUMNS
 from tailbeam.solvers.stream.active.compiled.pairs import clamp_indicator
 
 
@@ -34,6 +35,9 @@ class ContactStates:
         Its time (s; NaN before the first accepted step of the contact).
     pen : ndarray, shape (P,)
         Maximum penetration (m) of the contact so far.
+    imp : ndarray, shape (P, IMP_COLUMNS)
+        With friction: normal impulse (N s), tangential impulse on ball i (3, N s) and the
+        energy friction dissipated (J) of the contact so far (``compiled.friction``).
     """
 
     def __init__(self, n_pairs: int):
@@ -43,20 +47,22 @@ class ContactStates:
         self.peak = np.zeros(n_pairs)
         self.t_peak = np.full(n_pairs, math.nan)
         self.pen = np.zeros(n_pairs)
+        self.imp = np.zeros((n_pairs, IMP_COLUMNS))
 
     def arrays(self) -> tuple:
         """The ``pstate`` tuple of ``kernel.advance`` (the arrays themselves, not copies)."""
-        return (self.touching, self.ramp, self.clamped, self.peak, self.t_peak, self.pen)
+        return (self.touching, self.ramp, self.clamped, self.peak, self.t_peak, self.pen,
+                self.imp)  # fmt: skip
 
     def of(self, p: int) -> tuple:
-        """(touching, ramp, clamped, peak N, t_peak s, pen m) of pair p."""
+        """(touching, ramp, clamped, peak N, t_peak s, pen m, impulses ``imp[p]``) of pair p."""
         return (self.touching[p], self.ramp[p], self.clamped[p], self.peak[p], self.t_peak[p],
-                self.pen[p])  # fmt: skip
+                self.pen[p], self.imp[p].copy())  # fmt: skip
 
     def put(self, p: int, state) -> None:
         """Pair p takes ``state`` (as ``of`` gives it: a pair carried over from another set)."""
         (self.touching[p], self.ramp[p], self.clamped[p], self.peak[p], self.t_peak[p],
-         self.pen[p]) = state  # fmt: skip
+         self.pen[p], self.imp[p]) = state  # fmt: skip
 
     def open(self, p: int, delta: float, rate: float, law) -> None:
         """Pair p, found overlapping, touches in the region of its state: penetration
@@ -68,6 +74,7 @@ class ContactStates:
         ind = clamp_indicator(delta, rate, k, e, c, d, self.ramp[p])
         self.clamped[p] = bool(clamp > 0 and c > 0 and ind < 0.0)
         self.peak[p], self.t_peak[p], self.pen[p] = 0.0, math.nan, delta
+        self.imp[p] = 0.0
 
     def start(self, p: int, delta: float) -> None:
         """Pair p starts touching at penetration ``delta`` (m, about 0: its start found by the
@@ -86,6 +93,7 @@ class ContactStates:
         """Pair p's peak force and maximum penetration start again at penetration ``delta``
         (m)."""
         self.peak[p], self.t_peak[p], self.pen[p] = 0.0, math.nan, max(delta, 0.0)
+        self.imp[p] = 0.0
 
     def accumulators(self, p: int) -> tuple[float, float, float]:
         """(peak force N, its time s, maximum penetration m) of pair p."""

@@ -45,6 +45,10 @@ class ActiveMembers:
     dead_loads : callable, optional
         () -> (xy (p, 2) m, weights (p,) N) of the balls resting on the plate outside the
         set (modal plate).
+    friction : FrictionPairs, optional
+        The pairs' friction (``friction_pairs``; rigid plate): the sets integrate the
+        members' angular velocities (``balls.w`` holds them while a ball is not in a built
+        set). None: frictionless.
 
     Attributes
     ----------
@@ -60,8 +64,9 @@ class ActiveMembers:
         The members' plate force histories.
     """
 
-    def __init__(self, balls, rtol, settle_energy, plate=None, dead_loads=None):
+    def __init__(self, balls, rtol, settle_energy, plate=None, dead_loads=None, friction=None):
         self.balls, self.rtol = balls, rtol
+        self.friction = friction
         self.plate = plate
         self.settle_energy = settle_energy
         self.modal = None if plate is None else PlatePairs(plate, balls, rtol, dead_loads)
@@ -107,10 +112,31 @@ class ActiveMembers:
             return
         for q, i in enumerate(self.members):
             self._x[i], self._v[i] = s.x[q].copy(), s.v[q].copy()
+        self._sync_spins()
         self._pairs = {k: s.contacts.of(p) for k, p in self.index.items()}
         self.carried.save(s, self.members, self.keys)
         if self.modal is not None:  # each plate pair keeps its mode shapes (its contact point)
             self.modal.save(s, self.index)
+
+    def _sync_spins(self):
+        """With friction: the built set's angular velocities into ``balls.w``."""
+        s = self.set
+        if self.friction is None or s is None or self.dirty:
+            return
+        for q, i in enumerate(self.members):
+            self.balls.w[i] = s.w[q]
+
+    def spin(self, i: int) -> np.ndarray:
+        """Angular velocity (3,) rad/s of ball i now (0 without friction)."""
+        if self.friction is None:
+            return np.zeros(3)
+        if self.dirty or self.set is None or i not in self.local:
+            return self.balls.w[i].copy()
+        return self.set.w[self.local[i]].copy()
+
+    def sync_spins(self):
+        """Bring ``balls.w`` up to date with the set (the end of the run)."""
+        self._sync_spins()
 
     def _ready(self) -> ActiveSet:
         """The built set (rebuilt first after a change)."""
@@ -131,6 +157,8 @@ class ActiveMembers:
         self._count()
         modal = {} if self.modal is None else self.modal.block(m, self.keys, self._x,
                                                                 self.quiet, self.now)  # fmt: skip
+        if self.friction is not None:
+            modal = {**modal, "friction": self.friction.table(self.keys), "w": b.w[m]}
         self.set = s = ActiveSet(
             [self._x[i] for i in m], [self._v[i] for i in m], b.mass[m], b.radius[m],
             np.array(pairs, dtype=np.int64).reshape(-1, 2), law_table(laws), b.g, b.half,
@@ -214,11 +242,15 @@ class ActiveMembers:
         return np.array([self.state(int(i))[0] for i in idx]).reshape(-1, 3)
 
     def energy(self, balls) -> float:
-        """Kinetic energy of ``balls`` (members) plus the elastic energy of all contacts (J):
-        what a contact among them can give to one of them."""
+        """Kinetic energy of ``balls`` (members; with friction their rotation's too, which
+        friction can turn into translation) plus the elastic energy of all contacts (J): what
+        a contact among them can give to one of them."""
         s = self._ready()
         q = [self.local[int(i)] for i in balls]
         kinetic = 0.5 * float(np.sum(s.model.mass[q] * np.sum(s.v[q] * s.v[q], axis=1)))
+        if self.friction is not None:
+            inertia = 0.4 * s.model.mass[q] * s.model.radius[q] ** 2
+            kinetic += 0.5 * float(np.sum(inertia * np.sum(s.w[q] * s.w[q], axis=1)))
         elastic = sum(s.contact_energy(p) for p in np.flatnonzero(s.contacts.touching))
         return kinetic + elastic
 
@@ -248,6 +280,12 @@ class ActiveMembers:
         self._set_compliance(key)
         step = first_contact_step(s.y, s.model.arrays(), p, self.rtol)
         self.h = min(self.h, step) if self.h else step
+
+    def impulses(self, key) -> np.ndarray:
+        """With friction: pair ``key``'s (normal impulse N s, tangential impulse on its first
+        ball (3) N s, energy friction dissipated J) so far (``compiled.friction.IMP_*``)."""
+        s = self._ready()
+        return s.contacts.imp[self.index[key]].copy()
 
     def reset_accumulators(self, key):
         """Peak force and maximum penetration of pair ``key`` start again from now."""

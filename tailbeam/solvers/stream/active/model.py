@@ -13,6 +13,7 @@ import numpy as np
 
 from tailbeam.errors import InputError
 from tailbeam.physics.contact_law import LAW_COLUMNS, law_table
+from tailbeam.solvers.stream.active.compiled.friction import F_COLUMNS
 from tailbeam.solvers.stream.active.compiled.pairs import L_CRES
 
 
@@ -40,6 +41,8 @@ class Model:
         None: 0).
     modes : ModalBlock
         The modal plate's modes (``modal_block``; none on the rigid plate).
+    friction : array_like, shape (P, F_COLUMNS), optional
+        The pairs' friction table (``compiled.friction``); None: frictionless.
 
     Attributes
     ----------
@@ -64,10 +67,12 @@ class Model:
         Modal frequencies (rad/s), damping ratios, constant modal forces (N/sqrt(kg)).
     phi : ndarray, shape (P, m)
         Mode shapes (1/sqrt(kg)) at each plate pair's contact point.
+    fric : ndarray, shape (P, F_COLUMNS) or (P, 0)
+        The friction table (no columns: frictionless).
     """
 
     def __init__(self, n, mass, radius, pairs, laws, gravity, half_sizes, settle_energy,
-                 compliance, modes):  # fmt: skip
+                 compliance, modes, friction=None):  # fmt: skip
         self.mass = np.asarray(mass, dtype=float).reshape(n).copy()
         self.radius = np.asarray(radius, dtype=float).reshape(n).copy()
         pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
@@ -89,12 +94,18 @@ class Model:
         self.alive = np.ones(n, dtype=bool)
         self.omega, self.zeta = modes.omega, modes.zeta
         self.phi, self.f_dead = modes.phi, modes.f_dead
+        self.fric = _friction_table(friction, len(self.pi))
+
+    @property
+    def friction(self) -> bool:
+        """Whether the set has friction (and the balls' angular velocities in its state)."""
+        return self.fric.shape[1] > 0
 
     def arrays(self) -> tuple:
         """The ``model`` tuple of ``kernel.advance`` (the arrays themselves, not copies)."""
         return (self.mass, self.radius, self.g, self.half, self.pi, self.pj, self.law,
                 self.rsum, self.settle_energy, self.alive, self.omega, self.zeta, self.phi,
-                self.f_dead)  # fmt: skip
+                self.f_dead, self.fric)  # fmt: skip
 
     def set_phi(self, p: int, shape) -> None:
         """Mode shapes (m,) 1/sqrt(kg) at plate pair p's new contact point (before it touches)."""
@@ -120,6 +131,16 @@ def _with_compliance(laws, pj, compliance) -> np.ndarray:
     if cres.shape != (len(pj),) or not np.all(np.isfinite(cres)) or np.any(cres < 0.0):
         raise InputError("compliance", f"must be {len(pj)} finite values >= 0 m/N (one per pair)")
     return np.ascontiguousarray(np.column_stack([laws, np.where(pj < 0, cres, 0.0)]))
+
+
+def _friction_table(friction, n_pairs) -> np.ndarray:
+    """(P, F_COLUMNS) friction table (``compiled.friction``), or (P, 0) without friction."""
+    if friction is None:
+        return np.zeros((n_pairs, 0))
+    table = np.ascontiguousarray(np.asarray(friction, dtype=float).reshape(-1, F_COLUMNS))
+    if table.shape[0] != n_pairs:
+        raise InputError("friction", f"one row per pair: got {table.shape[0]} for {n_pairs}")
+    return table
 
 
 def _check_positive(name, values):

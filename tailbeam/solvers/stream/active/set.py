@@ -131,15 +131,23 @@ class ActiveSet:
     compliance : array_like, shape (P,), optional
         Residual compliance (m/N) of each plate pair (default 0; entries of ball-ball pairs
         ignored; ``model.set_compliance`` changes one).
+    friction : array_like, shape (P, F_COLUMNS), optional
+        The pairs' friction table (``compiled.friction``; rigid plate): the state then holds
+        the balls' angular velocities after the modal block. None: frictionless.
+    w : array_like, shape (n, 3), optional
+        With friction: the balls' angular velocities (rad/s; default 0).
 
     Attributes
     ----------
-    y : ndarray, shape (6 n + 2 m,)
-        The state (in/out): positions, velocities, modal coordinates, their rates.
+    y : ndarray, shape (6 n + 2 m,) (+ 3 n with friction)
+        The state (in/out): positions, velocities, modal coordinates, their rates (and the
+        angular velocities).
     x, v : ndarray, shape (n, 3)
         Views of the positions (m) and velocities (m/s) in ``y``.
     q, qd : ndarray, shape (m,)
         Views of the modal state in ``y``.
+    w : ndarray, shape (n, 3) (with friction) or (0, 3)
+        View of the angular velocities (rad/s) in ``y``.
     model : Model
         Balls, pairs, laws, plate and modes (``alive``: balls still integrated).
     contacts : ContactStates
@@ -164,22 +172,26 @@ class ActiveSet:
                  settle_energy=None, rtol=1e-10, atol_x=None, atol_v=None, max_steps=100_000,
                  nodes_per_step=DEFAULT_NODES, row_capacity=4096, log_capacity=256,
                  omega=None, zeta=None, q=None, qd=None, phi=None, f_dead=None, atol_q=None,
-                 atol_qd=None, compliance=None):  # fmt: skip
+                 atol_qd=None, compliance=None, friction=None, w=None):  # fmt: skip
         x = np.asarray(x, dtype=float).reshape(-1, 3)
         n = x.shape[0]
         modes = ModalBlock.build(np.asarray(pairs).reshape(-1, 2).shape[0], omega, zeta, q, qd,
                                  phi, f_dead)  # fmt: skip
         nm = modes.omega.shape[0]
+        spins = [] if friction is None else [np.zeros(3 * n) if w is None else np.ravel(w)]
         self.y = np.concatenate(
-            [x.ravel(), np.asarray(v, dtype=float).reshape(n, 3).ravel(), modes.q, modes.qd]
-        )
+            [x.ravel(), np.asarray(v, dtype=float).reshape(n, 3).ravel(), modes.q, modes.qd,
+             *spins]
+        )  # fmt: skip
         self.x = self.y[: 3 * n].reshape(n, 3)
         self.v = self.y[3 * n : 6 * n].reshape(n, 3)
         self.q = self.y[6 * n : 6 * n + nm]
-        self.qd = self.y[6 * n + nm :]
+        self.qd = self.y[6 * n + nm : 6 * n + 2 * nm]
+        self.w = self.y[6 * n + 2 * nm :].reshape(-1, 3)  # (0, 3) without friction
         self.model = Model(n, mass, radius, pairs, laws, gravity, half_sizes, settle_energy,
-                           compliance, modes)  # fmt: skip
-        self.tol = Tolerances.build(rtol, n, modes.phi, atol_x, atol_v, atol_q, atol_qd)
+                           compliance, modes, friction)  # fmt: skip
+        self.tol = Tolerances.build(rtol, n, modes.phi, atol_x, atol_v, atol_q, atol_qd,
+                                    self.model.radius if spins else None)  # fmt: skip
         self.io = KernelIO(max_steps, nodes_per_step, row_capacity, log_capacity)
         self.contacts = ContactStates(len(self.model.pi))
         self.h = 0.0

@@ -44,6 +44,8 @@ class Balls:
         self.t0 = self.t_release.copy()
         self.x0 = np.array([p.position for p in self.particles], dtype=float).reshape(n, 3)
         self.v0 = np.array([p.velocity for p in self.particles], dtype=float).reshape(n, 3)
+        # angular velocities (rad/s): constant in flight; the active set's while in it
+        self.w = np.array([p.angular_velocity for p in self.particles], dtype=float).reshape(n, 3)
         self.g = np.asarray(incline.gravity_vector, dtype=float)
         self.g_slide = np.array([self.g[0], self.g[1], 0.0])
         self.half = incline.half_sizes

@@ -1,6 +1,8 @@
 """The stream driver's energy ledger (J): released = left + at the end + removed at rest +
 dissipated. Kinetic plus gravitational energy of the balls (potential 0 at the origin of the
-plate frame) and the elastic energy of their contacts."""
+plate frame) and the elastic energy of their contacts. With friction the kinetic energy
+includes the rotation's 1/2 I w^2 and friction's dissipation is its own line,
+``energy_friction`` (summed over the contacts as they end, ``records``)."""
 
 import numpy as np
 
@@ -27,6 +29,8 @@ class EnergyLedger:
         self.balls, self.act, self.stats = balls, act, stats
         for key in ENTRIES:
             stats[key] = 0.0
+        if act.friction is not None:
+            stats["energy_friction"] = 0.0
 
     def released(self, i: int, x, v) -> None:
         """Ball i enters the scene at x (m), v (m/s), possibly pressing on the plate."""
@@ -45,7 +49,11 @@ class EnergyLedger:
     def ball_energy(self, i: int, x, v) -> float:
         """Kinetic plus gravitational energy (J) of ball i at x (m), v (m/s)."""
         b = self.balls
-        return float(0.5 * b.mass[i] * (v @ v) - b.mass[i] * (b.g @ x))
+        energy = float(0.5 * b.mass[i] * (v @ v) - b.mass[i] * (b.g @ x))
+        if self.act.friction is not None:
+            w = self.act.spin(i)
+            energy += float(0.2 * b.mass[i] * b.radius[i] ** 2 * (w @ w))
+        return energy
 
     def elastic(self, i: int) -> float:
         """Elastic energy (J) of the contacts of ball i: its plate contact (resting or not)

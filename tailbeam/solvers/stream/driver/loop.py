@@ -36,8 +36,9 @@ from tailbeam.physics.contact_law import HERTZ_EXPONENT
 from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import note, quiet, task
+from tailbeam.solvers.stream.active.friction_pairs import FrictionPairs
 from tailbeam.solvers.stream.active.members import ActiveMembers
-from tailbeam.solvers.stream.driver.balls import SLIDE, Balls
+from tailbeam.solvers.stream.driver.balls import GONE, PENDING, SLIDE, Balls
 from tailbeam.solvers.stream.driver.clock import Clock
 from tailbeam.solvers.stream.driver.energy import EnergyLedger
 from tailbeam.solvers.stream.driver.frames import FrameRecorder
@@ -84,6 +85,12 @@ class StreamRun:
         Work counters and the energy ledger (J).
     frames : BallFrames or None
         Every ball's state at the frame times asked for (``solve_stream(frames=...)``).
+    angular_velocity : dict
+        With friction: every ball's angular velocity (3,) rad/s when it left or at the end,
+        by name (empty without friction).
+    final : dict
+        Name -> (position (3,) m, velocity (3,) m/s) at the end of every ball still on the
+        plate (released, not gone).
     """
 
     particles: list
@@ -96,6 +103,8 @@ class StreamRun:
     message: str
     stats: dict = field(default_factory=dict)
     frames: object = None
+    angular_velocity: dict = field(default_factory=dict)
+    final: dict = field(default_factory=dict)
 
 
 def solve_stream(
@@ -114,6 +123,7 @@ def solve_stream(
     plate=None,
     contacts=None,
     frames=(),
+    friction=None,
 ) -> StreamRun:
     """Simulate a stream of particles on an inclined plate.
 
@@ -145,6 +155,11 @@ def solve_stream(
         Frame times (s, increasing, within [0, duration]) at which every ball's state is
         recorded (``StreamRun.frames``); the integration stops at each, so a run with frames
         agrees with one without to the tolerance ``rtol``, not bit for bit.
+    friction : FrictionModel, optional
+        Friction and rolling resistance of every contact, the balls' rotation
+        (``tailbeam.physics.friction``; rigid plate only). None: frictionless. With friction
+        no contact is put at rest (``rest_speed`` and SETTLE unused): a ball on the plate is
+        integrated for as long as it touches it.
 
     Returns
     -------
@@ -160,10 +175,14 @@ def solve_stream(
     if contacts is None:
         contacts = LawOptions(exponent, damping, penetration, clamp)
     contacts = contact_table(particles, contacts, incline.plate.material)
+    if friction is not None and plate is not None:
+        raise InputError("contact.friction", "the fast stream solver runs friction on the "
+                         "rigid plate only (plate.model = \"rigid\")")  # fmt: skip
     for attempt in range(GRAZING_RETRIES + 1):
         if plate is not None:
             plate.reset()
-        sim = _Stream(particles, incline, duration, contacts, rtol, rest_speed, max_work, plate)
+        sim = _Stream(particles, incline, duration, contacts, rtol, rest_speed, max_work, plate,
+                      friction)  # fmt: skip
         sim.frames = FrameRecorder(frames, sim.balls, sim.act)
         try:
             run = _run(sim, duration, progress)
@@ -227,18 +246,26 @@ class _Stream:
         Bound on kernel steps plus events (WorkLimitError beyond).
     plate : StreamPlate or None
         The two-way modal plate, or None (the rigid plate).
+    friction : FrictionModel or None
+        The contacts' friction (rigid plate), or None.
     """
 
-    def __init__(self, particles, incline, duration, contacts, rtol, rest_speed, max_events, plate):
+    def __init__(self, particles, incline, duration, contacts, rtol, rest_speed, max_events, plate,
+                 friction=None):  # fmt: skip
         self.clock = clock = Clock(duration)
         self.balls = balls = Balls(particles, incline, contacts)
         self.plate, self.max_events, self.rounds = plate, max_events, 0
+        pairs = None
+        if friction is not None:
+            pairs = FrictionPairs(friction, [p.material.name for p in particles], balls.radius,
+                                  incline.plate.material.name)  # fmt: skip
+            rest_speed = 0.0  # (never at rest: the ball rolls, slides or is held by friction)
 
         def settle_energy(i: int) -> float:
             return 0.5 * balls.mass[i] * rest_speed**2
 
         self.act = act = ActiveMembers(balls, rtol, settle_energy, plate,
-                                       lambda: balls.resting(clock.t))  # fmt: skip
+                                       lambda: balls.resting(clock.t), pairs)  # fmt: skip
         self.ledger = EnergyLedger(balls, act, clock.stats)
         self.records = ContactRecords(balls, act, clock, rest_speed)
         self.loads = PlateLoads(balls, act.forces)
@@ -333,8 +360,22 @@ class _Stream:
         stats["wall_s"] = wall
         stats["contacts"] = len(self.records.contacts)
         rec = self.records
+        spins = {}
+        if act.friction is not None:
+            act.sync_spins()
+            spins = {name: b.w[q].copy() for q, name in enumerate(b.names)}
         return StreamRun(
             self._released(), rec.contacts, rec.leaves, rec.events, loads.loads,
             loads.dead_loads, 0, "reached the end of the simulated time", stats,
-            self.frames.frames if len(self.frames.frames.times) else None,
+            frames=self.frames.frames if len(self.frames.frames.times) else None,
+            angular_velocity=spins, final=self._final_states(duration),
         )  # fmt: skip
+
+    def _final_states(self, t: float) -> dict:
+        """Name -> (x, v) at time t (s) of the balls released and not gone."""
+        b, out = self.balls, {}
+        for i in np.flatnonzero((b.status != GONE) & (b.status != PENDING)):
+            i = int(i)
+            x, v = self.act.state(i) if b.in_set[i] else b.state(i, t)
+            out[b.names[i]] = (np.array(x, dtype=float), np.array(v, dtype=float))
+        return out

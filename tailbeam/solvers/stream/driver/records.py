@@ -11,6 +11,7 @@ import numpy as np
 
 from tailbeam.physics.hertz import hertz_contact_duration
 from tailbeam.results.records import PLATE, Event, EventKind, Impact, LeaveEvent
+from tailbeam.solvers.stream.active.compiled.friction import IMP_N, IMP_T, IMP_WORK
 
 REST_CONTACT_FACTOR = 50.0  # a plate contact longer than this many Hertz durations is at rest
 
@@ -61,7 +62,7 @@ class ContactRecords:
             )  # fmt: skip
         self.act.reset_accumulators(key)
         self.open[key] = recs
-        if j < 0:
+        if j < 0 and self.act.friction is None:  # (with friction: integrated while it lasts)
             self.limit[i] = t + REST_CONTACT_FACTOR * self._hertz_duration(i, recs[0].v_in)
         self.contacts.extend(recs)
         self.events.append(Event(t, b.names[i], EventKind.CONTACT_START, partner))
@@ -79,6 +80,7 @@ class ContactRecords:
         for rec, v_out in zip(recs, outs, strict=True):
             rec.t_end, rec.v_out, rec.approach_out, rec.end = t, v_out, float(w @ n), end
             rec.peak_force, rec.t_peak, rec.max_penetration = peak, t_peak, pen
+        self._friction(key, recs)
         self.events.append(Event(t, recs[0].ball, EventKind.CONTACT_END, recs[0].partner))
 
     def finish(self) -> None:
@@ -89,7 +91,26 @@ class ContactRecords:
             peak, t_peak, pen = self.act.accumulators(key)
             for rec in recs:
                 rec.peak_force, rec.t_peak, rec.max_penetration = peak, t_peak, pen
+            self._friction(key, recs)
         self.contacts.sort(key=lambda r: (r.t_start, r.ball))
+
+    def _friction(self, key, recs) -> None:
+        """With friction: the contact's impulses, how it ended tangentially (its slip speed
+        now against the stiction velocity) and the energy friction dissipated in it (to
+        ``stats["energy_friction"]``)."""
+        act = self.act
+        if act.friction is None:
+            return
+        imp = act.impulses(key)
+        i, j = key
+        xi, vi = act.state(i)
+        partner = (None, None, None) if j < 0 else (*act.state(j), act.spin(j))
+        end = act.friction.end(key, xi, vi, act.spin(i), *partner)
+        tangential = float(np.linalg.norm(imp[IMP_T : IMP_T + 3]))
+        for rec in recs:
+            rec.normal_impulse, rec.tangential_impulse = float(imp[IMP_N]), tangential
+            rec.tangential_end = end
+        self.clock.stats["energy_friction"] += float(imp[IMP_WORK])
 
     def _normal(self, key):
         """Contact normal (from partner to ball i), penetration (m), the balls' states."""

@@ -84,7 +84,8 @@ class SetEvents:
         others = [p for p in self.act.touching_pairs(i) if p != key]
         v_out = self.act.state(i)[1][2]
         slow = 0.0 <= v_out < self.rest_speed and self.balls.g[2] < 0.0
-        if self._grazing(i):  # ends and starts again at one instant: it rests on the plate
+        if self._grazing(i) and self.act.friction is None:  # ends and starts again at one
+            # instant: it rests on the plate (with friction it rolls or is held on)
             slow = True
             self.clock.count("grazing_rests")
         self.records.close(key, End.REST if slow and not others else End.SEPARATED)

@@ -161,7 +161,7 @@ def _row_crossing(kind, idx, fr, Y15, have, coef, y, B, pts, vinv, n, half, pi, 
 def detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
     """Earliest (s, kind, idx) of a row crossing in the step; kind -1 if none. (The tuples
     are unpacked once here: the helpers take arrays, see ``rhs_arrays``.)"""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
     Y15, have, coef, y, B, W15, have_w, proj = dense
     vals, wc, wv, wc2, wd, stack, tmp = ws

@@ -48,6 +48,13 @@ from tailbeam.solvers.numerics.dop853 import growth, shrink
 from tailbeam.solvers.numerics.jit import helper_njit
 from tailbeam.solvers.stream.active.compiled.events import detect, prepare
 from tailbeam.solvers.stream.active.compiled.fresh import MAX_FRESH, found_again, hand_back, mark
+from tailbeam.solvers.stream.active.compiled.friction import (
+    IMP_N,
+    IMP_T,
+    IMP_WORK,
+    pair_friction,
+    spin_offset,
+)
 from tailbeam.solvers.stream.active.compiled.pairs import (
     R_CONTACT,
     R_EDGE,
@@ -100,14 +107,16 @@ def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
     """Peak force / max penetration of the touching pairs on the accepted step (maximum of
     their Chebyshev interpolant, refined where the nodes come within 1 % of the record), and
     the plate force rows at ``nodes`` interior points and the step end."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
-    touching, ramp, clamped, peak, t_peak, pen = pstate
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
+    touching, ramp, clamped, peak, t_peak, pen, imp = pstate
     vals, wc, wv, wc2, wd, stack, tmp = ws
     Y15, have, coef, y, B, W15, have_w, proj = dense
     for p in range(pi.shape[0]):
         if not touching[p]:
             continue
         _pair_values(p, dense, pts, model, pstate, vals, wv)
+        if fric.shape[1] > 0:
+            _impulses(h, p, dense, pts, vinv, model, vals, imp, tmp)
         fmax = -math.inf
         for q in range(pts.shape[0]):
             fmax = max(fmax, vals[q])
@@ -128,9 +137,47 @@ def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
 
 
 @helper_njit
+def _impulses(h, p, dense, pts, vinv, model, forces, imp, tmp):
+    """Add touching pair p's impulses and friction work on the accepted step of h (s) to
+    ``imp`` (``friction.IMP_*``): its normal ``forces`` (N) and friction at the 15 Chebyshev
+    points integrated by the Clenshaw-Curtis rule of their interpolant (``cc_weight``); the
+    balls' states there from the dense output (into ``tmp``)."""
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
+    coef, y0 = dense[2], dense[3]
+    n = mass.shape[0]
+    off = spin_offset(n, omega.shape[0])
+    i, j = pi[p], pj[p]
+    for q in range(pts.shape[0]):
+        s = pts[q]
+        for b in (i, j):
+            if b < 0:
+                continue
+            for k in range(3):
+                for base in (3 * b, 3 * n + 3 * b, off + 3 * b):
+                    tmp[base + k] = dense_component(coef, y0, s, base + k)
+        _, _, nx, ny, nz = pair_state(tmp, n, i, j, rsum[p], phi, p)
+        r = pair_friction(tmp, n, off, i, j, p, nx, ny, nz, forces[q], fric)
+        wq = cc_weight(vinv, q) * h
+        imp[p, IMP_N] += wq * forces[q]
+        for k in range(3):
+            imp[p, IMP_T + k] += wq * r[k]
+        imp[p, IMP_WORK] += wq * r[9]
+
+
+@helper_njit
+def cc_weight(vinv, q):
+    """Clenshaw-Curtis weight on [0, 1] of Chebyshev point q: the integral of the
+    interpolant, c = vinv @ values and int_-1^1 T_k = 2 / (1 - k^2) for even k (halved)."""
+    w = 0.0
+    for k in range(0, vinv.shape[0], 2):
+        w += vinv[k, q] / (1.0 - k * k)
+    return w
+
+
+@helper_njit
 def _pair_values(p, dense, pts, model, pstate, forces, deltas):
     """Force (N) and penetration (m) of touching pair p at the 15 Chebyshev points."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     ramp, clamped = pstate[1], pstate[2]
     Y15, have, coef, y, B, W15, have_w, proj = dense
     n = mass.shape[0]
@@ -154,7 +201,7 @@ def _pair_values(p, dense, pts, model, pstate, forces, deltas):
 def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj):
     """Force rows of plate pair p at ``nodes`` interior points of the step and its end (the
     plate deflection under the ball from its projected dense output, ``project``)."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     ramp, clamped = pstate[1], pstate[2]
     n = mass.shape[0]
     i = pi[p]
@@ -177,8 +224,8 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
     """Apply the event of row (kind, idx) at time t, state y; returns the status to return
     with (EventCode.CONTACT_START, CONTACT_END, LEAVE) or EventCode.NONE for a kink handled
     here (logged)."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
-    touching, ramp, clamped, peak, t_peak, pen = pstate
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
+    touching, ramp, clamped, peak, t_peak, pen, imp = pstate
     n = mass.shape[0]
     if kind == R_EDGE:
         iout[IO_INDEX] = idx // 4
@@ -196,6 +243,8 @@ def _apply(kind, idx, t, y, model, pstate, rows, log, iout):
         touching[idx], ramp[idx], clamped[idx] = True, True, False
         delta = pair_state(y, n, pi[idx], pj[idx], rsum[idx], phi, idx)[0]
         peak[idx], t_peak[idx], pen[idx] = 0.0, math.nan, max(0.0, delta)
+        for k in range(imp.shape[1]):
+            imp[idx, k] = 0.0
         if pj[idx] < 0:
             f = pair_force(y, n, idx, pi, pj, law, rsum, ramp, clamped, phi, mass, g, omega,
                            zeta, fdead)[0]  # fmt: skip
@@ -231,7 +280,7 @@ def _apply_here(k, i, t, y, model, pstate, rows, log, iout, fresh, nfresh, f0):
 def _settle(y, model, pstate, count, plate_pair):
     """First ball whose only touching pair is the plate and whose excess energy
     (``settle_excess``) is below its settle energy; -1 if none. Checked at step ends."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     touching = pstate[0]
     n = mass.shape[0]
     for b in range(n):

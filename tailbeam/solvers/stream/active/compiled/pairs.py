@@ -53,6 +53,7 @@ from tailbeam.physics.impact import (
     region_force,
 )
 from tailbeam.solvers.numerics.jit import helper_njit
+from tailbeam.solvers.stream.active.compiled.friction import add_friction, spin_offset
 
 L_CRES = LAW_COLUMNS  # the residual compliance C (m/N), after the law's own columns
 RESIDUAL_RTOL = 1e-14  # relative convergence of the residual-flexibility force solve
@@ -208,16 +209,23 @@ def plate_force(p, z, vz, w, wd, acc, kappa, law, rsum, ramp, clamped):
 
 @helper_njit
 def rhs_arrays(y, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, omega, zeta,
-               phi, fdead, out):  # fmt: skip
+               phi, fdead, radius, fric, out):  # fmt: skip
     """dy/dt of the active set: gravity on every present ball plus the touching pairs, and the
-    modes (``_modal_rhs``). (Arrays passed one by one: unpacking the model tuple on every call
-    costs more than the right-hand side of a small set.)"""
+    modes (``_modal_rhs``); with friction (``fric`` has columns) the angular velocities'
+    rates and each touching pair's friction (``friction.add_friction``). (Arrays passed one
+    by one: unpacking the model tuple on every call costs more than the right-hand side of a
+    small set.)"""
     n = mass.shape[0]
     for b in range(n):
         for k in range(3):
             out[3 * b + k] = y[3 * n + 3 * b + k] if alive[b] else 0.0
             out[3 * n + 3 * b + k] = g[k] if alive[b] else 0.0
     _modal_rhs(y, n, omega, zeta, fdead, out)
+    with_friction = fric.shape[1] > 0
+    off = spin_offset(n, omega.shape[0])
+    if with_friction:
+        for q in range(off, off + 3 * n):
+            out[q] = 0.0
     for p in range(pi.shape[0]):
         if not touching[p]:
             continue
@@ -237,6 +245,8 @@ def rhs_arrays(y, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, om
             out[3 * n + 3 * j] -= a * nx
             out[3 * n + 3 * j + 1] -= a * ny
             out[3 * n + 3 * j + 2] -= a * nz
+        if with_friction:
+            add_friction(y, n, off, p, i, j, f, nx, ny, nz, mass, radius, fric, out)
 
 
 @helper_njit
@@ -262,9 +272,9 @@ def _plate_reaction(n, phi, p, f, out):
 @helper_njit
 def rhs(y, model, pstate, out):
     """``rhs_arrays`` with the model and pair-state tuples."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     rhs_arrays(y, mass, g, pi, pj, law, rsum, pstate[0], pstate[1], pstate[2], alive, omega,
-               zeta, phi, fdead, out)  # fmt: skip
+               zeta, phi, fdead, radius, fric, out)  # fmt: skip
 
 
 @helper_njit
@@ -339,7 +349,7 @@ def _distance_row(kind, idx, d2, rs, law, touching, ramp):
 def row_value(kind, idx, y, model, pstate):
     """g = sign x f + band of row (kind, idx) at state y (``row_value_arrays``, plate rows
     with ``plate_row_value``) with the model and pair-state tuples."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
     n = mass.shape[0]
     if kind != R_EDGE and pj[idx] < 0:
@@ -356,7 +366,7 @@ def row_value(kind, idx, y, model, pstate):
 def first_contact_step(y, model, p, rtol):
     """First step after a contact start (s): where the tau^(e+2) term of the penetration
     reaches rtol, t_s rtol^(1/(e+2)), and within half the ramp (as tailbeam.solvers.rigid)."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     n = mass.shape[0]
     i, j = pi[p], pj[p]
     m = mass[i] if j < 0 else mass[i] * mass[j] / (mass[i] + mass[j])
@@ -373,7 +383,7 @@ def settle_excess(y, model, p, b):
     1/2 m vz^2 + U(delta) - U(delta_s) - m g_n (delta - delta_s), delta_s = (m g_n / k)^(1/e)
     (on the modal plate: delta and vz relative to the plate under the ball; with residual
     flexibility U is ``plate_contact_energy`` and delta_s grows by C m g_n)."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     n = mass.shape[0]
     m = mass[b]
     k, e, cres = law[p, LAW_K], law[p, LAW_E], law[p, L_CRES]

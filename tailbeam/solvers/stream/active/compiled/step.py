@@ -25,7 +25,7 @@ EPS = 2.220446049250313e-16
 @helper_njit
 def stages(K, A, first, stop, y, h, model, pstate, tmp):
     """Runge-Kutta stages first..stop-1 into K (rows: stages)."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     touching, ramp, clamped = pstate[0], pstate[1], pstate[2]
     n = y.shape[0]
     for s in range(first, stop):
@@ -35,7 +35,7 @@ def stages(K, A, first, stop, y, h, model, pstate, tmp):
                 acc += A[s, j] * K[j, q]
             tmp[q] = y[q] + h * acc
         rhs_arrays(tmp, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, omega, zeta,
-                   phi, fdead, K[s])  # fmt: skip
+                   phi, fdead, radius, fric, K[s])  # fmt: skip
 
 
 @helper_njit
@@ -136,7 +136,7 @@ def project_plate(coef, y, model, p, proj):
     acc0 = -g_z + phi[p] . (f_dead - 2 zeta omega q' - omega^2 q) (``plate_free_acceleration``)
     into proj[0..2]; returns kappa = 1/m + phi[p] . phi[p] (1/kg). The modes projected on
     phi[p] first: O(modes) per step, not per point."""
-    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead = model
+    mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     n = mass.shape[0]
     nm = phi.shape[1]
     off = 6 * n
