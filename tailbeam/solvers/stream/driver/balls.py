@@ -44,6 +44,7 @@ class Balls:
         self.t0 = self.t_release.copy()
         self.x0 = np.array([p.position for p in self.particles], dtype=float).reshape(n, 3)
         self.v0 = np.array([p.velocity for p in self.particles], dtype=float).reshape(n, 3)
+        self.release_position = self.x0.copy()  # m: where each is released (a slot: moved)
         self.g = np.asarray(incline.gravity_vector, dtype=float)
         self.g_slide = np.array([self.g[0], self.g[1], 0.0])
         self.half = incline.half_sizes
