@@ -88,6 +88,21 @@ SCENES = {
         ),
         "auto",
     ),
+    "stream modal 400 particles, 20 deg, sensors' band": (  # the sensors' default bandwidth
+        _with(
+            "caving_stream.toml",
+            [
+                "duration = 6.0",
+                "stop = 5.0",
+                "inclination = 30.0",
+                "fmax = 10000.0",
+                "bandwidth = 10000.0\n",
+                "bandwidth = 10000.0\n",
+            ],
+            ["duration = 2.5", "stop = 2.0", "inclination = 20.0", "", "", ""],
+        ),  # fmt: skip
+        "auto",
+    ),
     "stream modal 15 kHz one-way": (
         _with(
             "caving_stream.toml",

@@ -94,7 +94,8 @@ def run_case(seed: int, plate: str, duration: float) -> dict:
     return row
 
 
-DELIVERY = ("drawn_in_window", "released_in_window", "delivered_rate", "delayed_releases")
+DELIVERY = ("drawn_in_window", "released_in_window", "delivered_rate", "delayed_releases",
+            "moved_releases")  # fmt: skip
 
 
 def _plain(value):

@@ -1,12 +1,19 @@
-"""Test-suite setup: the modal-basis cache lives in a fresh folder per test session, so results
-never come from (or go to) a user's ~/.cache/tailbeam and every run measures cold work."""
+"""Test-suite setup: the modal-basis and compiled-kernel cache lives in a fresh folder per test
+session, so results never come from (or go to) a user's ~/.cache/tailbeam and every run
+measures cold work. pytest-xdist's workers inherit the folder from the process that starts
+them (``TAILBEAM_TEST_CACHE_DIR``), so a kernel or a basis one worker has made is not made
+again by the other (both are written atomically). ``TAILBEAM_TEST_CACHE_DIR=FOLDER`` makes a
+session use (and keep) FOLDER instead."""
 
 import os
 import tempfile
 
 import pytest
 
-_CACHE = tempfile.mkdtemp(prefix="tailbeam-test-cache-")
+_CACHE = os.environ.get("TAILBEAM_TEST_CACHE_DIR") or tempfile.mkdtemp(
+    prefix="tailbeam-test-cache-"
+)
+os.environ["TAILBEAM_TEST_CACHE_DIR"] = _CACHE
 os.environ["TAILBEAM_CACHE_DIR"] = _CACHE
 
 

@@ -22,7 +22,7 @@ def tailbeam(*args, cwd=None):
         capture_output=True,
         text=True,
         cwd=cwd,
-        timeout=300,
+        timeout=3600,  # a hang guard, not a timing: a loaded machine may take many minutes
     )
 
 

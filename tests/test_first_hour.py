@@ -45,8 +45,9 @@ def test_numba_cache_lives_outside_the_package(tmp_path):
     shadowed an editable reinstall)."""
     env = dict(os.environ, TAILBEAM_CACHE_DIR=str(tmp_path))
     env.pop("NUMBA_CACHE_DIR", None)
-    code = (
-        "import tailbeam, numba; from tailbeam.paper.scenarios import run_all; run_all(); "
+    code = (  # one cached kernel compiled in a fresh process: the folder is numba's, global
+        "import tailbeam, numba; from tailbeam.physics.contact_law import impact_force_array; "
+        "impact_force_array(1e-5, 0.0, 1e9, 1.5, 0.0, 1e-4, False); "
         "print(numba.config.CACHE_DIR)"
     )
     out = subprocess.run(

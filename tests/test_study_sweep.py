@@ -52,13 +52,20 @@ scene = "base.toml"
 
 
 @pytest.fixture(scope="module")
-def scheduler():
+def scheduler(tmp_path_factory):
+    """Two local workers. This module's modal bases go to a folder of its own (the session's
+    folder is shared with pytest-xdist's other workers, which may add bases at any time);
+    the compiled kernels stay the session's."""
+    from tailbeam.cachedir import numba_cache_dir
     from tailbeam.study.sweep import local_cluster
 
-    cluster = local_cluster(2)
-    assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
-    yield cluster.scheduler_address
-    cluster.close()
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("NUMBA_CACHE_DIR", str(numba_cache_dir()))
+        mp.setenv("TAILBEAM_CACHE_DIR", str(tmp_path_factory.mktemp("sweep-cache")))
+        cluster = local_cluster(2)
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        yield cluster.scheduler_address
+        cluster.close()
 
 
 def _run(tmp: Path, address: str, fmax: str, capsys):

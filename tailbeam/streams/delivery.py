@@ -1,8 +1,8 @@
 """What a stream delivered: its releases in its window against what it was asked for.
 
-A solver releases a particle later than drawn when a ball already there (a rebound) would
-overlap it; ``delivery`` compares the particles as released with
-those drawn, per stream:
+A solver releases a particle whose place a ball already there (a rebound) takes at another
+free place of its release volume, or later than drawn when it finds none; ``delivery``
+compares the particles as released with those drawn, per stream:
 
     rate                 the requested rate, particles/s
     window_s             [start, end] in s: the release window, cut at the simulated duration
@@ -12,6 +12,7 @@ those drawn, per stream:
     delivered_rate       released_in_window / (end - start), particles/s
     release_delay_max    largest delay of a release after its drawn time, s
     delayed_releases     particles released after their drawn time
+    moved_releases       particles released at another place of the release volume
 """
 
 import math
@@ -46,6 +47,7 @@ def delivery(streams, drawn, released, duration: float) -> dict:
             "delivered_rate": in_window / (t1 - t0) if t1 > t0 else math.nan,
             "release_delay_max": float(np.max(t_real - t_drawn, initial=0.0)),
             "delayed_releases": int(np.count_nonzero(t_real > t_drawn)),
+            "moved_releases": sum(d.position != r.position for d, r in pairs),
         }
     return out
 
@@ -56,6 +58,7 @@ def delivery_line(name: str, d: dict) -> str:
     return (
         f"stream {name}: delivered {d['delivered_rate']:.4g} particles/s of the {d['rate']:g} "
         f"asked ({d['released_in_window']} released in [{t0:g}, {t1:g}) s, "
-        f"{d['drawn_in_window']} drawn); {d['delayed_releases']} released late, largest "
-        f"release delay {d['release_delay_max']:.3g} s"
+        f"{d['drawn_in_window']} drawn); {d['moved_releases']} moved to a free place of the "
+        f"release volume, {d['delayed_releases']} released late, largest release delay "
+        f"{d['release_delay_max']:.3g} s"
     )

@@ -43,7 +43,7 @@ or lower the rate). Collisions between particles after release are the solver's 
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.special import ndtr, ndtri
@@ -98,10 +98,39 @@ class StreamSettings:
     angular_velocity_spread: float = 0.0
 
 
+SLOT_KEY = 6  # spawn key of the free-slot draws (the six quantities use 0-5)
+
+
+@dataclass(frozen=True)
+class ReleaseSlot:
+    """Where particle ``index`` (k - 1) of a stream may be released: its centre over ``area``
+    (m) with a gap in ``height`` (m) below it; candidates for a free slot at the release time
+    come from the particle's own Generator (PCG64, SeedSequence(seed, spawn_key=(SLOT_KEY,
+    index))), so they depend on the seed and k alone."""
+
+    area: tuple
+    height: tuple
+    seed: int
+    index: int
+    max_tries: int
+
+    def candidates(self, radius: float) -> np.ndarray:
+        """``max_tries`` candidate centres (m, max_tries x 3) for a particle of ``radius`` (m),
+        drawn as the generator draws a release position."""
+        seq = np.random.SeedSequence(self.seed, spawn_key=(SLOT_KEY, self.index))
+        u = np.random.Generator(np.random.PCG64(seq)).random((self.max_tries, 3))
+        (x0, x1), (y0, y1) = self.area
+        h0, h1 = self.height
+        return np.column_stack(
+            [x0 + u[:, 0] * (x1 - x0), y0 + u[:, 1] * (y1 - y0), radius + h0 + u[:, 2] * (h1 - h0)]
+        )
+
+
 @dataclass(frozen=True)
 class Particle:
     """A released particle: position (m), velocity (m/s) and angular velocity (rad/s) at its
-    release time t_release."""
+    release time t_release; ``slot``: where a solver may move its release if a ball is in the
+    way (None: nowhere)."""
 
     name: str
     stream: str
@@ -113,6 +142,7 @@ class Particle:
     position: tuple
     velocity: tuple
     angular_velocity: tuple = (0.0, 0.0, 0.0)
+    slot: ReleaseSlot | None = field(default=None, compare=False, repr=False)
 
     def ball(self) -> Ball:
         """The particle as a ``tailbeam.Ball`` at its release state."""
@@ -447,8 +477,9 @@ def _place(d: _Draws, k: int, t: float, zone: _Zone) -> Particle:
     gangue = bool(d.gangue[k])
     material = s.gangue_material if gangue else s.coal_material
     mass = material.density * 4.0 / 3.0 * math.pi * r**3
+    slot = ReleaseSlot(s.area, s.height, s.seed, k, s.max_tries)
     return Particle(
         f"{s.name}-{k + 1}", s.name, "gangue" if gangue else "coal", material, r, mass,
         float(t), tuple(float(c) for c in x), tuple(float(c) for c in v),
-        tuple(float(c) for c in d.spins[k]),
+        tuple(float(c) for c in d.spins[k]), slot,
     )  # fmt: skip

@@ -254,13 +254,14 @@ class ActiveMembers:
         elastic = sum(s.contact_energy(p) for p in np.flatnonzero(s.contacts.touching))
         return kinetic + elastic
 
-    def elastic_energy_of(self, i: int) -> float:
-        """Elastic energy (J) of member i's touching plate pair plus half of each of its
-        touching ball-ball pairs."""
+    def elastic_energy_of(self, i: int, ball_share: float = 0.5) -> float:
+        """Elastic energy (J) of member i's touching plate pair plus ``ball_share`` of each of
+        its touching ball-ball pairs (half: the other half is its partner's; 1: the pairs
+        vanish with i, as when it leaves over an edge)."""
         s = self._ready()
         total = 0.0
         for key in self.touching_pairs(i):
-            share = 1.0 if key[1] < 0 else 0.5
+            share = 1.0 if key[1] < 0 else ball_share
             total += share * s.contact_energy(self.index[key])
         return total
 

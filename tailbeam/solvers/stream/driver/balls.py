@@ -46,6 +46,7 @@ class Balls:
         self.v0 = np.array([p.velocity for p in self.particles], dtype=float).reshape(n, 3)
         # angular velocities (rad/s): constant in flight; the active set's while in it
         self.w = np.array([p.angular_velocity for p in self.particles], dtype=float).reshape(n, 3)
+        self.release_position = self.x0.copy()  # m: where each is released (a slot: moved)
         self.g = np.asarray(incline.gravity_vector, dtype=float)
         self.g_slide = np.array([self.g[0], self.g[1], 0.0])
         self.half = incline.half_sizes

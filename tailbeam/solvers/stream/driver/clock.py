@@ -7,7 +7,8 @@ COUNTERS = (
     "set_calls",  # calls of the active set
     "epochs",  # epochs of the broad phase
     "late_starts",  # balls that entered the set already overlapping (must stay 0)
-    "postponed_releases",  # particles released later: they would overlap a ball
+    "postponed_releases",  # particles released later: no free place in their release volume
+    "moved_releases",  # particles released at their time at another free place of the volume
 )
 
 

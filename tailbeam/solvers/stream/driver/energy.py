@@ -39,8 +39,10 @@ class EnergyLedger:
         self.stats["energy_released"] += self.ball_energy(i, x, v) + on_plate
 
     def left(self, i: int, x, v) -> None:
-        """Ball i leaves the plate over an edge at x (m), v (m/s)."""
-        self.stats["energy_left"] += self.ball_energy(i, x, v) + self.elastic(i)
+        """Ball i leaves the plate over an edge at x (m), v (m/s). Its contacts end with it,
+        so the whole elastic energy of each leaves too, its partners' halves included."""
+        whole = self.act.elastic_energy_of(i, 1.0) if i in self.act.members else self.elastic(i)
+        self.stats["energy_left"] += self.ball_energy(i, x, v) + whole
 
     def removed_at_rest(self, energy: float) -> None:
         """A ball put at rest lost ``energy`` (J) of normal motion."""

@@ -1,7 +1,11 @@
-"""What the stream driver does when a heap entry comes due (``heap``): a particle's release
-(postponed by RELEASE_RETRY while it would overlap a ball already there), a new epoch, a
-plate touch, the first touch of two balls, an edge crossing. A touch makes its balls join
-the active set (``membership``)."""
+"""What the stream driver does when a heap entry comes due (``heap``): a particle's release, a
+new epoch, a plate touch, the first touch of two balls, an edge crossing. A touch makes its
+balls join the active set (``membership``).
+
+A particle whose release position is taken by a ball already there (the generator knows only
+the free flights of earlier particles, not their rebounds) is released at its time at the
+first free candidate of its stream's release volume (``ReleaseSlot.candidates``: drawn from
+its seed and number alone), and only when none is free waits RELEASE_RETRY and tries again."""
 
 import numpy as np
 
@@ -66,11 +70,16 @@ class HeapEvents:
 
     def _release(self, i: int) -> None:
         b, t = self.balls, self.clock.t
-        if self._overlaps_at_release(i):
-            self.clock.stats["postponed_releases"] += b.t_release[i] == b.particles[i].t_release
-            b.t_release[i] = t + RELEASE_RETRY
-            self.heap.push(b.t_release[i], RELEASE, i)
-            return
+        centres, reach = self._occupants(i)
+        if _taken(centres, reach, b.x0[i][None, :])[0]:
+            slot = self._free_slot(i, centres, reach)
+            if slot is None:
+                self.clock.stats["postponed_releases"] += b.t_release[i] == b.particles[i].t_release
+                b.t_release[i] = t + RELEASE_RETRY
+                self.heap.push(b.t_release[i], RELEASE, i)
+                return
+            b.x0[i] = b.release_position[i] = slot
+            self.clock.stats["moved_releases"] += 1
         b.set_motion(i, FLY, t, b.x0[i].copy(), b.v0[i].copy())
         x, v = b.state(i, t)
         self.ledger.released(i, x, v)
@@ -79,9 +88,9 @@ class HeapEvents:
         if self.act.members:
             self.membership.refresh()
 
-    def _overlaps_at_release(self, i: int) -> bool:
-        """Does particle i, released now, overlap a ball already there (the generator
-        only knows the free flights of earlier particles, not their rebounds)?"""
+    def _occupants(self, i: int):
+        """(centres (m, k x 3), reach (m, k)) of the balls present now: a centre closer than
+        its reach to particle i's would overlap it."""
         b = self.balls
         others = b.closed_form()
         centres = b.states(others, self.clock.t)[0] if len(others) else np.empty((0, 3))
@@ -89,8 +98,17 @@ class HeapEvents:
         if core:
             centres = np.vstack([centres, self.act.positions(core)])
             others = np.concatenate([others, np.array(core, dtype=np.int64)])
-        reach = b.radius[others] + b.radius[i]
-        return bool(np.any(np.sum((centres - b.x0[i]) ** 2, axis=1) < reach**2))
+        return centres, b.radius[others] + b.radius[i]
+
+    def _free_slot(self, i: int, centres, reach):
+        """The first candidate of particle i's release volume that no ball takes now (m), or
+        None (none of them, or the particle has no release volume: a ``[[balls]]`` entry)."""
+        slot = self.balls.particles[i].slot
+        if slot is None:
+            return None
+        candidates = slot.candidates(self.balls.radius[i])
+        free = np.flatnonzero(~_taken(centres, reach, candidates))
+        return candidates[free[0]].copy() if len(free) else None
 
     def _leave(self, i: int, edge: str, t: float) -> None:
         """Closed-form ball i passes ``edge`` at t (s): gone."""
@@ -101,3 +119,12 @@ class HeapEvents:
         b.status[i] = GONE
         b.version[i] += 1
         self.records.leave(i, t, edge)
+
+
+def _taken(centres, reach, points) -> np.ndarray:
+    """For each of ``points`` (m, p x 3): does a ball of ``centres`` overlap it (distance
+    below its ``reach``)?"""
+    if not len(centres):
+        return np.zeros(len(points), dtype=bool)
+    d2 = np.sum((points[:, None, :] - centres[None, :, :]) ** 2, axis=2)
+    return np.any(d2 < reach[None, :] ** 2, axis=1)

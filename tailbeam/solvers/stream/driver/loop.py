@@ -331,12 +331,16 @@ class _Stream:
             )
 
     def _released(self) -> list:
-        """The particles with their actual release times."""
+        """The particles with their actual release times and positions."""
         b = self.balls
-        return [
-            p if b.t_release[q] == p.t_release else replace(p, t_release=float(b.t_release[q]))
-            for q, p in enumerate(b.particles)
-        ]
+        out = []
+        for q, p in enumerate(b.particles):
+            if b.t_release[q] != p.t_release:
+                p = replace(p, t_release=float(b.t_release[q]))
+            if np.any(b.release_position[q] != np.asarray(p.position)):
+                p = replace(p, position=tuple(float(c) for c in b.release_position[q]))
+            out.append(p)
+        return out
 
     def _finish(self, wall: float) -> StreamRun:
         """The end of the simulated time: final energies, the records and loads of what is
