@@ -40,6 +40,7 @@ THEORIES = ("auto", "kirchhoff", "mindlin")
 COUPLINGS = ("two-way", "one-way")
 TAILS = ("auto", "quasi-static", "ritz")
 DEFAULT_TAIL_MODES = 32  # Ritz pseudo-modes per contact point (docs/fe-convergence.md)
+DEFAULT_IMPACT_FACE = "top"  # plate.impact_face of a structure from plate.mesh
 STREAM_TAIL_MODES = 4  # a stream contact's tail oscillators (tailbeam.plate.contact_tail)
 
 
@@ -92,6 +93,10 @@ class ModalPlateSettings:
     point, a posteriori, 0.9-2.5 s per point; the coupled solver only) or None: the solver's
     default, 32 on the coupled solver (within 2e-5 of the full FE at 20 kHz on the default
     and the test meshes), 4 per contact on the stream solver (``tail_modes_for``).
+    mesh: a volume mesh file (absolute path) of the structure (None: the flat rectangular
+    plate); impact_face: its named face where particles land (default "top");
+    supports: tailbeam.plate.solid.Support of each ``[[plate.supports]]``
+    (docs/structures.md).
     """
 
     boundary: str = "SSSS"
@@ -104,8 +109,12 @@ class ModalPlateSettings:
     coupling: str = "two-way"
     tail: str = "auto"
     tail_modes: int | str | None = None
+    mesh: str | None = None
+    impact_face: str | None = None
+    supports: tuple = ()
 
     def __post_init__(self):
+        self._check_structure()
         code = self.boundary
         if not (isinstance(code, str) and len(code) == 4 and set(code.upper()) <= set("CSF")):
             raise InputError(
@@ -136,6 +145,16 @@ class ModalPlateSettings:
             if isinstance(n, bool) or not isinstance(n, int) or n < 1:
                 raise InputError("plate.mesh_divisions", f"must be a whole number >= 1, got {n!r}")
         self._check_tail()
+
+    def _check_structure(self):
+        if self.mesh is None:
+            for key, value in (("impact_face", self.impact_face), ("supports", self.supports)):
+                if value:
+                    raise InputError(f"plate.{key}", "needs plate.mesh (a structure's mesh file)")
+            return
+        if self.impact_face is None:
+            object.__setattr__(self, "impact_face", DEFAULT_IMPACT_FACE)
+        object.__setattr__(self, "supports", tuple(self.supports))
 
     def tail_modes_for(self, stream: bool) -> int | str:
         """plate.tail_modes as the solver uses it: the set value, else its default
@@ -225,6 +244,13 @@ class Scene:
         if self.modal is not None and self.modal.tail_modes is None:  # the solver's default
             k = self.modal.tail_modes_for(self.needs_stream_solver)
             object.__setattr__(self, "modal", replace(self.modal, tail_modes=k))
+        if self.modal is not None and self.modal.mesh is not None and self.needs_stream_solver:
+            raise InputError(
+                "plate.mesh",
+                "a structure from a mesh runs single balls only (the single-ball solver); "
+                "the stream solver (streams, an inclined plate or balls that may touch) does "
+                "not take plate.mesh yet",
+            )
 
     def _check_labels(self) -> None:
         labels = tuple(self.labels) or tuple(default_label(b) for b in self.balls)

@@ -26,6 +26,7 @@ from tailbeam.io.scene_file import (
     NOISE_KEYS,
     PLATE_KEYS,
     SENSOR_KEYS,
+    SUPPORT_KEYS,
     TOP_KEYS,
 )
 from tailbeam.streams.generator import KEYS as STREAM_KEYS
@@ -56,6 +57,7 @@ def scene_keys() -> list:
     names += [f"contact.friction.{k}" for k in FRICTION_KEYS]
     names += [f"contact.friction.pairs.{k}" for k in FRICTION_PAIR_KEYS]
     names += [f"plate.{k}" for k in PLATE_KEYS + MODAL_KEYS]
+    names += [f"plate.supports.{k}" for k in SUPPORT_KEYS]
     names += [f"materials.NAME.{k}" for k in MATERIAL_KEYS]
     names += [f"balls.{k}" for k in BALL_KEYS]
     names += [f"sensors.{k}" for k in SENSOR_KEYS]

@@ -13,6 +13,23 @@ from tailbeam.streams.generator import default_label
 MATERIAL_KEYS = ("density", "youngs_modulus", "poisson_ratio")
 
 
+def _structure(plate: dict, m) -> None:
+    """A structure from a mesh: its keys replace the flat plate's (size, boundary, theory,
+    mesh_divisions), which the scene reader refuses beside ``mesh``."""
+    for key in ("size", "boundary", "theory", "mesh_divisions"):
+        plate.pop(key, None)
+    plate.update(mesh=m.mesh, impact_face=m.impact_face)
+    keys = ("kind", "group", "region", "stiffness", "direction", "axis")
+    plate["supports"] = [
+        {k: _plain(getattr(s, k)) for k in keys if getattr(s, k) is not None} for s in m.supports
+    ]
+
+
+def _plain(value):
+    """Tuples (of tuples) as lists, for TOML."""
+    return [_plain(v) for v in value] if isinstance(value, tuple) else value
+
+
 def scene_to_dict(scene: Scene) -> dict:
     """The scene as a table with the scene-file keys (for echoing into results, or dumping)."""
     c = scene.contact
@@ -42,6 +59,8 @@ def scene_to_dict(scene: Scene) -> dict:
         # always written: the default changed ("quasi-static" -> "auto") and a dumped scene
         # (a sweep case, impacts.json) must mean the same run whatever the default is
         plate.update(tail=m.tail, tail_modes=m.tail_modes_for(scene.needs_stream_solver))
+        if m.mesh is not None:
+            _structure(plate, m)
     used = {b.material for b in scene.balls} | {p.material}
     used |= {m for s in scene.streams for m in (s.coal_material, s.gangue_material)}
     materials = {

@@ -26,6 +26,8 @@ from tailbeam.physics.friction import KEYS as FRICTION_VALUE_KEYS
 from tailbeam.physics.friction import FrictionModel, FrictionSettings
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import Material, get_material
+from tailbeam.plate.solid.held import held_structure
+from tailbeam.plate.solid.supports import Support, check_support
 from tailbeam.preflight import check_scene
 from tailbeam.preflight import magnitudes as plausible
 from tailbeam.scene import (
@@ -70,7 +72,13 @@ MODAL_KEYS = (
     "coupling",
     "tail",
     "tail_modes",
+    "mesh",
+    "impact_face",
+    "supports",
 )
+FLAT_ONLY = ("size", "boundary", "theory", "mesh_divisions")  # the flat plate's, not a mesh's
+FREE_HINT = "add supports, or ask for a free structure"  # the library's words, not a scene's
+SUPPORT_KEYS = ("kind", "group", "region", "stiffness", "direction", "axis")
 BALL_KEYS = ("name", "material", "radius", "position", "velocity", "label", "angular_velocity")
 SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance", "noise")
 NOISE_KEYS = ("rms", "background", "band", "seed")
@@ -88,26 +96,28 @@ def load_scene(path) -> Scene:
         raise InputError(
             path.name, f"is not UTF-8 text (invalid byte 0x{data[err.start]:02x} at line {line})"
         ) from None
-    return loads_scene(text, source=path.name)
+    return loads_scene(text, source=path.name, base_dir=path.parent)
 
 
-def loads_scene(text: str, *, source: str = "scene") -> Scene:
-    """Parse TOML ``text``; ``source`` names it in the error of unparseable TOML."""
+def loads_scene(text: str, *, source: str = "scene", base_dir=None) -> Scene:
+    """Parse TOML ``text``; ``source`` names it in the error of unparseable TOML; paths in
+    it (``plate.mesh``) are relative to ``base_dir`` (default the working directory)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         # The message carries "(at line L, column C)".
         raise InputError(source, f"is not valid TOML: {err}") from None
-    return parse_scene(data)
+    return parse_scene(data, base_dir=base_dir)
 
 
-def parse_scene(data: dict) -> Scene:
-    """Build a Scene from the parsed TOML table ``data``."""
+def parse_scene(data: dict, *, base_dir=None) -> Scene:
+    """Build a Scene from the parsed TOML table ``data`` (paths relative to ``base_dir``)."""
     _check_keys("", data, TOP_KEYS, required=("duration",) if "streams" in data else REQUIRED)
     materials = _parse_materials(data.get("materials", {}))
     contact_table = _table("contact", data.get("contact", {}))
     contact = _parse_contact(contact_table)
-    plate, model, modal = _parse_plate(_table("plate", data.get("plate", {})), materials)
+    plate_table = _table("plate", data.get("plate", {}))
+    plate, model, modal = _parse_plate(plate_table, materials, base_dir)
     friction = _parse_friction(contact_table, materials, plate)
     kwargs = {}
     if "inclination" in _table("plate", data.get("plate", {})):
@@ -238,7 +248,7 @@ def _parse_friction(contact: dict, materials: dict, plate: Plate) -> FrictionMod
     return FrictionModel(model.default, tuple(pairs))
 
 
-def _parse_plate(table: dict, materials: dict):
+def _parse_plate(table: dict, materials: dict, base_dir=None):
     model = table.get("model", "rigid")
     allowed = PLATE_KEYS + MODAL_KEYS if model == "modal" else PLATE_KEYS
     for key in table:
@@ -278,8 +288,68 @@ def _parse_plate(table: dict, materials: dict):
             )
         if "tail_modes" in table:
             m["tail_modes"] = table["tail_modes"]  # "auto" or a whole number, checked there
+        if "mesh" in table:
+            m.update(_parse_structure(table, base_dir))
+        for key in ("impact_face", "supports"):
+            if key in table and "mesh" not in table:
+                raise InputError(f"plate.{key}", "needs plate.mesh (a structure's mesh file)")
         modal = ModalPlateSettings(**m)
+        if modal.mesh is not None:  # built now: every check before any work
+            plate = _structure_plate(modal, plate.material)
     return plate, model, modal
+
+
+def _structure_plate(modal: ModalPlateSettings, material) -> Plate:
+    """The impact face's rectangle (thickness of material below its centre) of the scene's
+    structure, which is built here so that every check of it comes first."""
+    try:
+        model = held_structure(modal.mesh, modal.impact_face, modal.supports, material)
+    except InputError as err:  # a scene has no free structures: say what to add
+        raise InputError(err.field, err.rule.replace(FREE_HINT, "add [[plate.supports]]")) from None
+    return model.plate
+
+
+def _parse_structure(table: dict, base_dir) -> dict:
+    """``plate.mesh`` (relative to the scene file), ``impact_face`` and ``supports``."""
+    for key in FLAT_ONLY:
+        if key in table:
+            raise InputError(
+                f"plate.{key}",
+                "is the flat plate's; a structure from plate.mesh takes its shape from the "
+                "mesh and is held by plate.supports",
+            )
+    path = Path(_string("plate.mesh", table["mesh"]))
+    if not path.is_absolute():
+        path = Path(base_dir or ".") / path
+    out = {"mesh": str(path.resolve())}
+    if "impact_face" in table:
+        out["impact_face"] = _string("plate.impact_face", table["impact_face"])
+    rows = _array_of_tables("plate.supports", table.get("supports", []))
+    out["supports"] = tuple(_parse_support(f"plate.supports[{i}]", t)
+                            for i, t in enumerate(rows, start=1))  # fmt: skip
+    return out
+
+
+def _parse_support(field: str, table: dict) -> Support:
+    _check_keys(field, table, SUPPORT_KEYS, required=("kind",))
+    kwargs = {"kind": _string(f"{field}.kind", table["kind"])}
+    if kwargs["kind"] == "spring" and "stiffness" not in table:
+        raise InputError(f"{field}.stiffness", "a spring support needs its stiffness, N/m")
+    if "group" in table:
+        kwargs["group"] = _string(f"{field}.group", table["group"])
+    if "stiffness" in table:
+        kwargs["stiffness"] = require_real(f"{field}.stiffness", table["stiffness"])
+    for key in ("direction", "axis"):
+        if key in table:
+            kwargs[key] = tuple(require_vector(f"{field}.{key}", table[key], 3))
+    if "region" in table:
+        box = table["region"]
+        if not (isinstance(box, list) and len(box) == 3):
+            raise InputError(f"{field}.region", "must be [[x0, x1], [y0, y1], [z0, z1]] m")
+        kwargs["region"] = tuple(
+            tuple(require_vector(f"{field}.region[{i}]", r, 2)) for i, r in enumerate(box, 1)
+        )
+    return check_support(Support(**kwargs), field)
 
 
 def _parse_balls(value, materials: dict, plate: Plate, has_streams: bool) -> tuple:
@@ -359,6 +429,12 @@ def _parse_sensors(value, plate: Plate) -> tuple:
             raise InputError(
                 f"{field}.name",
                 f"{name!r} may hold only letters, digits and _ . + - (it names output files)",
+            )
+        if isinstance(t["position"], list) and len(t["position"]) == 3:
+            raise InputError(
+                f"{field}.position",
+                "a point (x, y, z) on a structure's surface is not supported yet; give (x, y) "
+                "m on the impact face (read along its normal)",
             )
         x, y = require_vector(f"{field}.position", t["position"], 2)
         if not plate.contains(x, y):

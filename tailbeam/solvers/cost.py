@@ -79,16 +79,20 @@ SENSOR_MEMORY_LIMIT = 3.0e9  # bytes: or hold more
 @dataclass(frozen=True)
 class Part:
     """One piece of a run's work: its name, estimated time (s) and peak memory (bytes),
-    what drives it (words), and whether its result is already cached (time ~0)."""
+    what drives it (words), whether its result is already cached (time ~0), and whether it
+    is estimated at all (``estimated`` False: time and memory count as 0, said so)."""
 
     name: str
     time_s: float
     memory_bytes: float
     driver: str = ""
     cached: bool = False
+    estimated: bool = True
 
     def describe(self) -> str:
         what = f" ({self.driver})" if self.driver else ""
+        if not self.estimated:
+            return f"{self.name}{what} not estimated"
         return f"{self.name}{what} {'cached' if self.cached else _seconds(self.time_s)}"
 
 

@@ -26,8 +26,10 @@ def basis_signature(scene) -> str:
     p = scene.plate
     mat = p.material
     band = _band(scene)
+    structure = [m.mesh, m.impact_face, repr(m.supports)] if m.mesh is not None else []
     return json.dumps(
-        [
+        structure
+        + [
             [p.size_x, p.size_y, p.thickness],
             [mat.density, mat.youngs_modulus, mat.poisson_ratio],
             m.boundary,
@@ -63,6 +65,8 @@ def warm_basis(scene_toml: str) -> str:
         scene = loads_scene(scene_toml)
         if scene.plate_model != "modal":
             return "rigid plate: no basis"
+        if scene.modal.mesh is not None:
+            return "structure from plate.mesh: its modes are not cached, each case solves them"
         band = stream_band(scene) if scene.needs_stream_solver else None
         with quiet():  # a worker's notes and bars would interleave on the user's terminal
             basis = build_basis(scene, band)

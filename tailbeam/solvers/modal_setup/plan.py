@@ -22,8 +22,9 @@ from tailbeam.plate.fe.mindlin import DEFAULT_DEGREE
 from tailbeam.plate.fe.model import resolve_mesh
 from tailbeam.plate.fe.modes import _estimated_count
 from tailbeam.plate.fe.resolution import resolve
+from tailbeam.plate.solid.held import held_structure
 from tailbeam.scene import ModalPlateSettings
-from tailbeam.solvers.cost import eigen_part, setup_part
+from tailbeam.solvers.cost import Part, eigen_part, setup_part
 from tailbeam.solvers.modal_setup.band import (
     BAND_GRID_HZ,
     STREAM_MIN_BAND_HZ,
@@ -63,6 +64,9 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
     settings = scene.modal or ModalPlateSettings()
     band = band or (stream_band(scene) if stream else choose_band(scene, settings))
     fmax = band["fmax_hz"]
+    if settings.mesh is not None:
+        check_structure_solver(settings, stream)
+        return _structure_plan(scene, settings, band)
     try:
         dofs, modes, cached, divisions, theory = _size(scene, settings, fmax)
         if cached is None:  # refused as compute_modes would refuse it, before the estimate
@@ -85,6 +89,33 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
     two_way = settings.coupling == "two-way"
     return BasisPlan(tuple(parts), modes, fmax, two_way, tail_k,
                      _alternative(scene, settings, band, stream, parts), dofs, ritz)  # fmt: skip
+
+
+def check_structure_solver(settings, stream: bool) -> None:
+    """A structure from plate.mesh runs on the single-ball solver only: InputError naming
+    plate.mesh on the stream solvers' set-up (``stream``)."""
+    if settings.mesh is not None and stream:
+        raise InputError(
+            "plate.mesh",
+            "a structure from a mesh runs on the single-ball solver only; the stream solvers "
+            "(--solver stream, stream-reference) do not take plate.mesh yet",
+        )
+
+
+def _structure_plan(scene, settings, band: dict) -> BasisPlan:
+    """A structure from plate.mesh: its DOFs are known (the scene reader built it), the cost
+    of its modes is not estimated (no model of a solid's mode count and factor fill yet);
+    the modes the simulation and replay are costed with are the impact face's flat plate's
+    Weyl count, a floor for a structure with ribs and walls below the face."""
+    fmax = band["fmax_hz"]
+    model = held_structure(settings.mesh, settings.impact_face, settings.supports,
+                           scene.plate.material)  # fmt: skip
+    driver = (f"structure from plate.mesh, {model.n_dofs} DOFs, band {fmax / 1e3:g} kHz: "
+              "cost of the structure's modes not estimated, not cached")  # fmt: skip
+    modes = _estimated_count(scene.plate, parse_boundary("CCCC"), "mindlin", fmax)
+    parts = (Part("eigen-solve", 0.0, 0.0, driver, estimated=False),
+             setup_part(model.n_dofs, 0))  # fmt: skip
+    return BasisPlan(parts, modes, fmax, settings.coupling == "two-way", 0, "", model.n_dofs, 0)
 
 
 def _ritz_points(scene, settings, theory: str) -> int:

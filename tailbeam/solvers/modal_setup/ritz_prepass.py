@@ -187,6 +187,8 @@ def _why_not_ritz(settings, basis) -> str | None:
         return "plate.residual_flexibility is off"
     if settings.coupling != "two-way":
         return "one-way coupling"
+    if basis.theory == "solid":
+        return "the Ritz tail is not built on a structure from a mesh yet"
     try:
         ritz_tail.check_fe_basis(basis)
     except InputError:
@@ -235,6 +237,12 @@ def check_tail_scene(scene) -> None:
                 f"(default {STREAM_TAIL_MODES})",
             )
         return
+    if settings.tail == "ritz" and settings.mesh is not None:
+        raise InputError(
+            "plate.tail",
+            "'ritz' is not built on a structure from plate.mesh yet; use 'quasi-static' or "
+            "'auto' (its residual flexibility is the structure's static compliance)",
+        )
     tail_modes = settings.tail_modes_for(stream=False)
     if settings.tail == "ritz" and tail_modes != "auto":
         _check_work(tail_modes, len(_unique(first_contacts(scene, "kirchhoff"))))

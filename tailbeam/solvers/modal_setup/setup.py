@@ -16,9 +16,12 @@ from tailbeam.errors import InputError
 from tailbeam.plate.basis import ModalBasis, modal_damping
 from tailbeam.plate.contact_tail import ContactTail
 from tailbeam.plate.fe.modes import compute_modes
+from tailbeam.plate.solid.held import held_structure
+from tailbeam.plate.solid.modes import structure_modes
 from tailbeam.progress import note
 from tailbeam.scene import ModalPlateSettings, Scene
 from tailbeam.solvers.modal_setup.band import check_stream_band, choose_band, stream_band
+from tailbeam.solvers.modal_setup.plan import check_structure_solver
 from tailbeam.solvers.modal_setup.ritz_prepass import apply_tail, check_tail_scene, describe_tail
 
 SCENE_FIELDS = {"fmax_hz": "plate.fmax", "divisions": "plate.mesh_divisions"}
@@ -82,6 +85,7 @@ def stream_setup(scene: Scene) -> ModalSetup:
     """The modal plate of a stream scene: the sensors' band (checked against the stream's
     shortest contacts), its basis and, where they apply, the contact tails."""
     settings = scene.modal or ModalPlateSettings()
+    check_structure_solver(settings, stream=True)
     check_tail_scene(scene)  # before any work
     band = stream_band(scene)
     if band["tail_band_hz"] is None and settings.tail != "quasi-static":
@@ -105,6 +109,8 @@ def build_basis(scene: Scene, band: dict | None = None, *, use_cache: bool = Tru
     naming plate.fmax."""
     settings = scene.modal or ModalPlateSettings()
     band = band or choose_band(scene, settings)
+    if settings.mesh is not None:
+        return structure_basis(scene, settings, band)
     try:
         return compute_modes(
             scene.plate, settings.boundary, theory=settings.theory, fmax_hz=band["fmax_hz"],
@@ -112,6 +118,21 @@ def build_basis(scene: Scene, band: dict | None = None, *, use_cache: bool = Tru
         )  # fmt: skip
     except InputError as err:
         raise err.renamed(SCENE_FIELDS) from None
+
+
+def structure_basis(scene: Scene, settings: ModalPlateSettings, band: dict):
+    """The modes below the band of the scene's structure from ``plate.mesh``
+    (``tailbeam.plate.solid``; the model is the one the scene reader built). Not cached:
+    every run solves them again."""
+    model = held_structure(settings.mesh, settings.impact_face, settings.supports,
+                           scene.plate.material)  # fmt: skip
+    note(
+        f"structure from plate.mesh: {model.n_dofs} DOFs, {model.element}; its modes to "
+        f"{band['fmax_hz'] / 1e3:g} kHz are solved now (not cached)"
+    )
+    basis = structure_modes(model, fmax_hz=band["fmax_hz"])
+    basis.info["cache"] = "off"
+    return basis
 
 
 def contact_tail(scene: Scene, band: dict, basis: ModalBasis) -> ContactTail:
