@@ -139,3 +139,12 @@ def test_a_1e9_hz_sensor_is_refused_by_simulate_before_any_work():
         tailbeam.simulate(modal(rate=1e9, duration=0.01), progress=False)
     assert err.value.field == "sensors[1].sample_rate"
     assert "lower it or the duration" in err.value.rule
+
+
+def test_a_total_names_the_parts_it_leaves_out():
+    # a part that is not estimated counts as 0 s: the headline total must say it is partial
+    parts = (C.Part("eigen-solve", 0.0, 0.0, estimated=False), C.Part("simulation", 2.0, 1e8))
+    line = C.RunCost(parts).describe()
+    assert line.startswith("estimated cost without the eigen-solve (not estimated) ")
+    whole = C.RunCost(parts[1:]).describe()
+    assert whole.startswith("estimated cost ") and "without" not in whole

@@ -117,9 +117,15 @@ class RunCost:
         return next((p for p in self.parts if p.name == name), None)
 
     def describe(self) -> str:
-        """One line: the total, then each part, then the alternative."""
+        """One line: the total (naming the parts it leaves out, if any are not estimated),
+        then each part, then the alternative."""
         parts = ", ".join(p.describe() for p in self.parts)
-        line = f"estimated cost {_seconds(self.time_s)}, ~{self.memory_bytes / 1e6:.0f} MB: {parts}"
+        unknown = [p.name for p in self.parts if not p.estimated]
+        head = "estimated cost"
+        if unknown:
+            head = f"estimated cost without the {' and '.join(unknown)} (not estimated)"
+        total = f"{head} {_seconds(self.time_s)}, ~{self.memory_bytes / 1e6:.0f} MB"
+        line = f"{total}: {parts}"
         return f"{line}; {self.alternative}" if self.alternative else line
 
     def as_dict(self) -> dict:
