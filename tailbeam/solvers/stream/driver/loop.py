@@ -182,8 +182,7 @@ def solve_stream(
         if plate is not None:
             plate.reset()
         sim = _Stream(particles, incline, duration, contacts, rtol, rest_speed, max_work, plate,
-                      friction)  # fmt: skip
-        sim.frames = FrameRecorder(frames, sim.balls, sim.act)
+                      friction, frames)  # fmt: skip
         try:
             run = _run(sim, duration, progress)
         except _Stuck as err:
@@ -248,10 +247,12 @@ class _Stream:
         The two-way modal plate, or None (the rigid plate).
     friction : FrictionModel or None
         The contacts' friction (rigid plate), or None.
+    frames : sequence of float
+        Frame times (s) at which every ball's state is recorded (``FrameRecorder``).
     """
 
     def __init__(self, particles, incline, duration, contacts, rtol, rest_speed, max_events, plate,
-                 friction=None):  # fmt: skip
+                 friction=None, frames=()):  # fmt: skip
         self.clock = clock = Clock(duration)
         self.balls = balls = Balls(particles, incline, contacts)
         self.plate, self.max_events, self.rounds = plate, max_events, 0
@@ -275,7 +276,7 @@ class _Stream:
         shared = (*parts, self.membership, self.records, self.loads, self.ledger)
         self.set_events = SetEvents(*shared, rest_speed)
         self.heap_events = HeapEvents(*shared, plate)
-        self.frames = FrameRecorder((), balls, act)
+        self.frames = FrameRecorder(frames, balls, act)
 
     def run(self, bar) -> StreamRun:
         """Run to the end; ``bar.update(ms)`` is told the simulated time reached."""
