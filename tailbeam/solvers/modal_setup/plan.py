@@ -22,6 +22,7 @@ from tailbeam.plate.fe.mindlin import DEFAULT_DEGREE
 from tailbeam.plate.fe.model import resolve_mesh
 from tailbeam.plate.fe.modes import _estimated_count
 from tailbeam.plate.fe.resolution import resolve
+from tailbeam.plate.solid.cost import structure_cost
 from tailbeam.plate.solid.held import held_structure
 from tailbeam.scene import ModalPlateSettings
 from tailbeam.solvers.cost import Part, eigen_part, setup_part
@@ -103,19 +104,19 @@ def check_structure_solver(settings, stream: bool) -> None:
 
 
 def _structure_plan(scene, settings, band: dict) -> BasisPlan:
-    """A structure from plate.mesh: its DOFs are known (the scene reader built it), the cost
-    of its modes is not estimated (no model of a solid's mode count and factor fill yet);
-    the modes the simulation and replay are costed with are the impact face's flat plate's
-    Weyl count, a floor for a structure with ribs and walls below the face."""
+    """A structure from plate.mesh: its DOFs and matrices are known (the scene reader built
+    it); its eigen-solve is estimated from them (``tailbeam.plate.solid.cost``), and the
+    simulation and replay are costed with that estimate's modes."""
     fmax = band["fmax_hz"]
     model = held_structure(settings.mesh, settings.impact_face, settings.supports,
                            scene.plate.material)  # fmt: skip
-    driver = (f"structure from plate.mesh, {model.n_dofs} DOFs, band {fmax / 1e3:g} kHz: "
-              "cost of the structure's modes not estimated, not cached")  # fmt: skip
-    modes = _estimated_count(scene.plate, parse_boundary("CCCC"), "mindlin", fmax)
-    parts = (Part("eigen-solve", 0.0, 0.0, driver, estimated=False),
+    cost = structure_cost(model, fmax)
+    driver = (f"structure from plate.mesh, band {fmax / 1e3:g} kHz from "
+              f"{_why(band, False)}: {cost.describe()}, not cached")  # fmt: skip
+    parts = (Part("eigen-solve", cost.time_s, cost.memory_bytes, driver),
              setup_part(model.n_dofs, 0))  # fmt: skip
-    return BasisPlan(parts, modes, fmax, settings.coupling == "two-way", 0, "", model.n_dofs, 0)
+    return BasisPlan(parts, cost.n_modes, fmax, settings.coupling == "two-way", 0, "",
+                     model.n_dofs, 0)  # fmt: skip
 
 
 def _ritz_points(scene, settings, theory: str) -> int:
