@@ -32,6 +32,7 @@ estimate, they do not bound.
 """
 
 import math
+import os
 from dataclasses import dataclass
 
 from tailbeam.errors import InputError
@@ -136,6 +137,19 @@ class RunCost:
                                "cached": p.cached, "driver": p.driver} for p in self.parts},
             "alternative": self.alternative,
         }  # fmt: skip
+
+
+def load_stretch() -> tuple:
+    """(stretch, load average, cores): how many times longer than the estimate (the CPU
+    time of one core, which the run gets whole on an idle machine) its wall time may be on
+    this machine now: the 1-minute load average over the cores, at least 1 (the run shares
+    the cores with that many running processes)."""
+    cores = os.cpu_count() or 1
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):  # not on every platform
+        return 1.0, 0.0, cores
+    return max(1.0, load / cores), load, cores
 
 
 def _seconds(t: float) -> str:

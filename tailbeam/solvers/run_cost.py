@@ -11,6 +11,7 @@ from tailbeam.solvers.cost import (
     RunCost,
     check_replay,
     coupled_part,
+    load_stretch,
     reference_part,
     replay_part,
     rigid_part,
@@ -101,7 +102,13 @@ def _simulation(scene, solver, n_modes: int, plan):
 
 def announce_run(scene, solver) -> RunCost:
     """Estimate the run (``estimate_run``, which refuses what is beyond the limits) and say
-    the estimate on stderr, before any work."""
+    the estimate on stderr, before any work, with the stretch of the machine's current load
+    (``cost.load_stretch``) when it is 1.5 or more."""
     cost = estimate_run(scene, solver)
-    note(cost.describe())
+    stretch, load, cores = load_stretch()
+    busy = ""
+    if stretch >= 1.5:
+        busy = (f"; on this machine's load ({load:.1f} on {cores} cores) the wall time may be "
+                f"~{stretch:.1f}x that")  # fmt: skip
+    note(cost.describe() + busy)
     return cost
