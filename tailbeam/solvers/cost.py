@@ -5,8 +5,8 @@ per piece of work, each with its own model here and its time (s), peak memory (b
 drives it and whether it is already cached:
 
 - ``eigen-solve``: the modal basis of the band (DOFs counted on the mesh, modes by Weyl's
-  count, ``tailbeam.plate.fe.cost``): time EIGEN_TIME x N m^2 (shift-invert Lanczos
-  orthogonalises each new vector against ~1.5 m others), nothing if the basis is cached
+  count): the assembly, two factorisations and the shift-invert solves with their
+  orthogonalisation (``tailbeam.plate.fe.cost.solve_time``), nothing if the basis is cached
   (loading it: CACHE_LOAD_BYTES_PER_S);
 - ``contact tails``: a stream's wider basis to the tails' band on the band's own mesh, the
   same model;
@@ -36,9 +36,8 @@ import os
 from dataclasses import dataclass
 
 from tailbeam.errors import InputError
+from tailbeam.plate.fe.cost import solve_time
 
-EIGEN_TIME = 1.5e-8  # s / (DOF mode^2) of a Lanczos band solve, one BLAS thread
-EIGEN_BASE = 0.6  # s: assembling the FE model and factorising, per solve
 EIGEN_WORDS = 6.0  # doubles per DOF per mode held during the solve (and by a loaded basis)
 BASE_MEMORY = 2.0e8  # bytes: interpreter, numpy, scipy, numba
 MODAL_BASE_MEMORY = 3.0e8  # bytes: the same with the FE assembly and the modal kernels
@@ -165,7 +164,7 @@ def eigen_part(name: str, n_dofs: int, n_modes: int, cached_bytes: float | None,
     memory = MODAL_BASE_MEMORY + 8.0 * EIGEN_WORDS * n_dofs * n_modes
     if cached_bytes is not None:
         return Part(name, cached_bytes / CACHE_LOAD_BYTES_PER_S, memory, driver, cached=True)
-    return Part(name, EIGEN_BASE + EIGEN_TIME * n_dofs * n_modes**2, memory, driver)
+    return Part(name, solve_time(n_dofs, n_modes), memory, driver)
 
 
 def setup_part(n_dofs: int, ritz_points: int) -> Part:
