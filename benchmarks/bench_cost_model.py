@@ -202,6 +202,7 @@ SOLID_CASES = {
     "solid box beam 40 cells, 4 kHz": ("box", {"cells_x": 40}, 4000.0),
 }
 BEAM_CASE = ("example tail beam, 2 kHz", ("beam", {}, 2000.0))
+PLATE_CASES = {f"flat plate, {f / 1e3:g} kHz": f for f in (5000.0, 10000.0, 20000.0)}
 
 
 def _structure(kind, params, path):
@@ -274,6 +275,33 @@ def measure_solid(name: str) -> dict:
             "load": [load0, os.getloadavg()[0]]}  # fmt: skip
 
 
+def measure_plate(name: str) -> dict:
+    """Estimate, then solve the default flat plate's band (modal_plate.toml's plate, Mindlin,
+    no cache), in CPU seconds (in this process)."""
+    from tailbeam.io.scene_file import loads_scene
+    from tailbeam.plate.fe.modes import compute_modes
+
+    plate = loads_scene((EXAMPLES / "modal_plate.toml").read_text()).plate
+    load0, c0, t0 = os.getloadavg()[0], time.process_time(), time.perf_counter()
+    basis = compute_modes(plate, "SSSS", theory="mindlin", fmax_hz=PLATE_CASES[name],
+                          use_cache=False, blas_threads=1)  # fmt: skip
+    cpu, wall = time.process_time() - c0, time.perf_counter() - t0
+    est = basis.info["cost_estimate"]
+    return {"name": name, "n_dofs": basis.info["n_dofs"], "modes_estimated": est["n_modes"],
+            "modes": basis.n_modes, "time_estimated": est["time_s"], "cpu": cpu, "wall": wall,
+            "memory_estimated": est["memory_bytes"],
+            "memory_measured": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0,
+            "load": [load0, os.getloadavg()[0]]}  # fmt: skip
+
+
+def _plate_line(r):
+    return (f"| {r['name']} | {r['n_dofs']} | {r['modes_estimated']} / {r['modes']} | "
+            f"{r['time_estimated']:.3g} / {r['cpu']:.3g} ({r['cpu'] / r['time_estimated']:.2f})"
+            f" | {r['wall']:.3g} | {r['memory_estimated'] / 1e6:.0f} / "
+            f"{r['memory_measured'] / 1e6:.0f} | {r['load'][0]:.1f}-{r['load'][1]:.1f} |"
+    )  # fmt: skip
+
+
 def _solid_line(r):
     return (f"| {r['name']} | {r['n_dofs']} | {r['modes_estimated']} / {r['modes']} | "
             f"{r['entries_estimated'] / 1e6:.2f} / {r['entries'] / 1e6:.2f} | "
@@ -302,8 +330,9 @@ def main(argv=None):
         warm_up()
         return 0
     if args.child:
-        solid = args.child.startswith("solid:")
-        row = measure_solid(args.child[6:]) if solid else measure(args.child)
+        kind, _, name = args.child.partition(":")
+        run = {"solid": measure_solid, "plate": measure_plate}.get(kind)
+        row = run(name) if run else measure(args.child)
         print(json.dumps(row))
         return 0
     out = Path(args.out)
@@ -311,6 +340,7 @@ def main(argv=None):
     if args.solid:
         names = [*SOLID_CASES, *([BEAM_CASE[0]] if args.beam else [])]
         rows = _children(out, [f"solid:{n}" for n in args.only or names], _solid_line)
+        rows += _children(out, [f"plate:{n}" for n in PLATE_CASES], _plate_line)
         (out / "solid_cost.json").write_text(json.dumps(rows, indent=1))
         print(f"wrote {out / 'solid_cost.json'}")
         return 0

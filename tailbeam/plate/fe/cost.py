@@ -6,10 +6,10 @@ work of ``modes._solve_band`` (CPU seconds of one core, one BLAS thread):
 
 - assembling the FE model: ASSEMBLY_PER_DOF per DOF;
 - two factorisations (the shift's, and Sylvester's count at fmax) with SuperLU's minimum
-  degree, whose factor on these 2-D meshes has F = FILL x N^(4/3) entries (measured 6.97 x
-  on 6 815 DOFs, 7.08 x on 13 735, 7.0 x on 29 799), each FACTOR_PER_FLOP x F^2 / N;
+  degree, whose factor on these 2-D meshes has F = FILL x N^(4/3) entries (measured 7.10 x
+  on 6 815 DOFs, 7.11 x on 13 735, 6.81 x on 29 799), each FACTOR_PER_FLOP x F^2 / N;
 - shift-invert Lanczos for nev modes in ncv = 1.5 nev + 20 vectors: 2 nev + 25 solves
-  (137, 249 measured for 52, 112 modes: 2 nev + 25 exactly at 10 kHz), each a forward and
+  (measured 137, 249, 501 for 52, 112, 253 modes), each a forward and
   back substitution (SOLVE_PER_ENTRY x F), the products with M (STEP_PER_DOF x N) and the
   orthogonalisation of the new vector against ~(nev + ncv) / 2 others (2 flops each per DOF,
   ORTH_PER_FLOP).
@@ -28,8 +28,8 @@ from tailbeam.errors import InputError
 
 FILL = 7.0  # factor entries / N^(4/3), SuperLU minimum degree on the plate's meshes
 ASSEMBLY_PER_DOF = 6e-5  # s per DOF: the FE model's assembly (measured 5-6e-5)
-FACTOR_PER_FLOP = 6e-10  # s per F^2/N of a factorisation (measured 5-7e-10)
-SOLVE_PER_ENTRY = 2.2e-9  # s per factor entry and solve (measured 2.0-2.6e-9)
+FACTOR_PER_FLOP = 6e-10  # s per F^2/N of a factorisation (measured 4-7e-10)
+SOLVE_PER_ENTRY = 2.0e-9  # s per factor entry and solve (measured 1.8-2.2e-9)
 STEP_PER_DOF = 1e-7  # s per DOF and solve: ARPACK's products with M
 ORTH_PER_FLOP = 1e-9  # s per flop of orthogonalisation (memory-bound dgemv)
 SOLVES_PER_MODE, SOLVES_BASE = 2.0, 25.0  # ARPACK's solves: 2 nev + 25
