@@ -179,4 +179,6 @@ def _alternative(scene, settings, band, stream, parts) -> str:
     if stream and band.get("tail_band_hz"):
         cost *= 1.0 + solves[1].time_s / max(solves[0].time_s, 1e-9)  # the tails scale alike
     key = "sensors[i].bandwidth" if _why(band, stream).startswith("the sensors") else "plate.fmax"
-    return f"{half / 1e3:g} kHz would take ~{cost:.0f} s for the bases: set {key}"
+    now = sum(p.time_s for p in solves)
+    return (f"the bases of {band['fmax_hz'] / 1e3:g} kHz ~{now:.0f} s; {half / 1e3:g} kHz would "
+            f"take ~{cost:.0f} s for the bases: set {key}")  # fmt: skip
