@@ -324,6 +324,9 @@ def main(argv=None):
     parser.add_argument("--beam", action="store_true",
                         help="with --solid: also the example tail beam to 2 kHz (~3 GB, "
                         "~3 CPU min)")  # fmt: skip
+    parser.add_argument("--again", metavar="JSON",
+                        help="no runs: tabulate DIR/cost_model.json's measurements of an "
+                        "earlier run against the current model's estimates")  # fmt: skip
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.child == "warm-up":
@@ -337,6 +340,12 @@ def main(argv=None):
         return 0
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.again:
+        rows = [_estimate_again(row) for row in json.loads(Path(args.again).read_text())]
+        for row in rows:
+            print(_line(row))
+        _write_csv(out, rows)
+        return 0
     if args.solid:
         names = [*SOLID_CASES, *([BEAM_CASE[0]] if args.beam else [])]
         rows = _children(out, [f"solid:{n}" for n in args.only or names], _solid_line)
@@ -350,6 +359,27 @@ def main(argv=None):
     (out / "cost_model.json").write_text(json.dumps(rows, indent=1))
     print(f"load average at the end: {os.getloadavg()[0]:.1f}; wrote {out / 'cost_model.csv'}")
     return 0
+
+
+def _estimate_again(row: dict) -> dict:
+    """``row`` (a scene's measurement) with the current model's estimates."""
+    from tailbeam.io.scene_file import loads_scene
+    from tailbeam.progress import quiet
+    from tailbeam.simulation import choose_solver
+    from tailbeam.solvers.run_cost import estimate_run
+
+    text, solver = SCENES[row["name"]]
+    scene = loads_scene(text)
+    with quiet():
+        cost = estimate_run(scene, choose_solver(scene, solver))
+    estimated = {p: cost.part(p).time_s for p in ("simulation", "writing")}
+    bases = [p for p in cost.parts if p.name in ("eigen-solve", "contact tails", "set-up")]
+    if "bases" in row["estimated"]:
+        estimated["bases"] = sum(p.time_s for p in bases)
+    if cost.part("sensor replay"):
+        estimated["sensor replay"] = cost.part("sensor replay").time_s
+    return {**row, "estimated": estimated, "total_estimated": cost.time_s,
+            "memory_estimated": cost.memory_bytes, "line": cost.describe()}  # fmt: skip
 
 
 def _children(out, names, line):
