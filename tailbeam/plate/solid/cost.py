@@ -29,10 +29,12 @@ average, squared).
 
 The rates (s per unit of work) are CPU seconds of one core, measured with
 ``benchmarks/bench_cost_model.py --solid`` on small meshes (process CPU time, which the
-machine's load changes little, where wall time under a load of 5-10 on 2 cores was 3-6x
-longer); the example beam at 2 kHz (81 640 DOFs, 121 modes) is the check, not the fit.
-Memory: the factor (values and row indices, 12 bytes an entry, one factor at a time), the
-matrices and their shifted and permuted copies, the Lanczos vectors and the returned modes.
+machine's load changes little, where wall time under a load of 13-16 on 2 cores was 5-13x
+longer); the example beam at 2 kHz is the check, not the fit: 81 640 DOFs, 121 modes
+(estimated 233), 74.8 M factor entries (86 M), 287 solves (495), 81 s CPU (167 s), 2.7 GB
+peak (2.3 GB). Memory: the factor (values and row indices, 12 bytes an entry, one factor at
+a time), the matrices and their shifted and permuted copies, the Lanczos vectors and the
+returned modes.
 """
 
 import math
