@@ -165,3 +165,11 @@ def test_the_line_names_what_the_band_costs_and_what_half_of_it_would():
     half = float(cost.alternative[len(bases) :].split(" ")[0])
     assert half < eigen.time_s
     assert cost.describe().endswith(cost.alternative)
+
+
+def test_the_load_stretch_is_the_load_over_the_cores(monkeypatch):
+    monkeypatch.setattr(C.os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(C.os, "getloadavg", lambda: (6.0, 5.0, 4.0))
+    assert C.load_stretch() == (3.0, 6.0, 2)
+    monkeypatch.setattr(C.os, "getloadavg", lambda: (0.5, 0.5, 0.5))
+    assert C.load_stretch()[0] == 1.0  # an idle machine: the estimate itself
