@@ -25,7 +25,7 @@ from tailbeam.plate.fe.resolution import resolve
 from tailbeam.plate.solid.cost import structure_cost
 from tailbeam.plate.solid.held import held_structure
 from tailbeam.scene import ModalPlateSettings
-from tailbeam.solvers.cost import Part, eigen_part, setup_part
+from tailbeam.solvers.cost import Part, eigen_part, setup_part, stream_setup_part
 from tailbeam.solvers.modal_setup.band import (
     BAND_GRID_HZ,
     STREAM_MIN_BAND_HZ,
@@ -85,8 +85,7 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
                                 f"modes to {wide / 1e3:g} kHz"))  # fmt: skip
         tail_k = int(band.get("tail_oscillators", 0))
     ritz = 0 if stream else _ritz_points(scene, settings, theory)
-    if not stream:
-        parts.append(setup_part(dofs, ritz))
+    parts.append(stream_setup_part() if stream else setup_part(dofs, ritz))
     two_way = settings.coupling == "two-way"
     return BasisPlan(tuple(parts), modes, fmax, two_way, tail_k,
                      _alternative(scene, settings, band, stream, parts), dofs, ritz)  # fmt: skip
