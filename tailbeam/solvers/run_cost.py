@@ -80,8 +80,9 @@ def estimate_run(scene, solver, *, band: dict | None = None, writes: bool = True
         check_replay(scene, n_modes, top_hz)
         particles = len(scene.particles) if solver.stream else 0
         ritz_dofs = plan.n_dofs if plan.ritz_points else 0
+        balls = 0 if solver.stream else len(scene.balls)
         parts.append(replay_part(scene.sensors, scene.duration, n_modes, top_hz, particles,
-                                 ritz_dofs))  # fmt: skip
+                                 ritz_dofs, balls))  # fmt: skip
     if writes:
         parts.append(write_part(scene, not solver.stream, modal_sensors))
     return RunCost(tuple(parts), alternative)
@@ -96,8 +97,10 @@ def _simulation(scene, solver, n_modes: int, plan):
         return stream_part(len(scene.particles), n_modes, plan.tail_oscillators)
     if scene.plate_model == "rigid":
         return rigid_part(expected_impacts(scene))
+    settings = scene.modal
+    flexible = settings is None or (settings.residual_flexibility and settings.mesh is None)
     return coupled_part(expected_impacts(scene), len(scene.balls), n_modes,
-                        DEFAULT_STEPS_PER_CONTACT)  # fmt: skip
+                        DEFAULT_STEPS_PER_CONTACT, plan.n_dofs if flexible else 0)  # fmt: skip
 
 
 def announce_run(scene, solver) -> RunCost:

@@ -85,7 +85,8 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
                                 f"modes to {wide / 1e3:g} kHz"))  # fmt: skip
         tail_k = int(band.get("tail_oscillators", 0))
     ritz = 0 if stream else _ritz_points(scene, settings, theory)
-    parts.append(stream_setup_part() if stream else setup_part(dofs, ritz))
+    pulses = 0 if band.get("user_fmax") else len(scene.balls)
+    parts.append(stream_setup_part() if stream else setup_part(dofs, ritz, pulses))
     two_way = settings.coupling == "two-way"
     return BasisPlan(tuple(parts), modes, fmax, two_way, tail_k,
                      _alternative(scene, settings, band, stream, parts), dofs, ritz)  # fmt: skip
