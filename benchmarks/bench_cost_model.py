@@ -1,19 +1,29 @@
-"""The run cost model (tailbeam.solvers.cost, run_cost) against measured wall times.
+"""The run cost model (tailbeam.solvers.cost, run_cost) against measured CPU and wall times.
 
     OMP_NUM_THREADS=1 python benchmarks/bench_cost_model.py --out DIR [--only NAME ...]
+    OMP_NUM_THREADS=1 python benchmarks/bench_cost_model.py --out DIR --solid [--beam]
+    python benchmarks/bench_cost_model.py --out DIR --again DIR/cost_model.json
 
 For each scene of a spread (single balls and grids, streams, rigid and modal plates, bands
 2-40 kHz, light and heavy sensors) the estimate is taken first (``estimate_run``, as
-``tailbeam simulate`` prints it), then every part is timed on its own: the plate set-up (the
-eigen-solves of the band and the contact tails; a basis in the user's cache counts as cached,
-as it does for a user), the solver's run, the sensor replay and writing the outputs. The
-compiled kernels are warmed up first (their one-time compilation is not in the model).
-Peak memory is the process's maximum resident size after the scene (ru_maxrss; each scene in
-its own process), against the estimate's largest part.
+``tailbeam simulate`` prints it), then every part is timed on its own, in process CPU
+seconds (what the model estimates: one core's time) and wall seconds, with the load average
+at the start and end: the plate set-up (the eigen-solves of the band and the contact tails;
+a basis in the user's cache counts as cached, as it does for a user), the solver's run, the
+sensor replay and writing the outputs. The compiled kernels are warmed up first (their
+one-time compilation is not in the model; the package's sources key numba's cache, so an
+edit of tailbeam recompiles). Peak memory is the process's maximum resident size after the
+scene (ru_maxrss; each scene in its own process), against the estimate's largest part.
 
-Writes DIR/cost_model.csv (per scene and part: estimated and measured seconds, their ratio)
-and prints the table of docs/band-and-cost.md. ~10-15 min on the 2-core machine when the
-bases to 40 kHz are cached (an uncached 40 kHz solve adds 3-10 min).
+``--solid``: the eigen-solves on their own, each in its own process: structures from small
+volume meshes (tests/solid_meshes.py) and the default flat plate to 20 kHz, estimated modes,
+factor entries, solves, CPU time and memory against SuperLU's factor, ARPACK's solves and the
+process's peak (``--beam``: the example tail beam to 2 kHz too, ~3 GB). ``--again``: no
+runs, an earlier run's measurements against the current model's estimates.
+
+Writes DIR/cost_model.csv (per scene and part: estimated, CPU and wall seconds, their ratio,
+the load) or DIR/solid_cost.json, and prints the tables of docs/band-and-cost.md. 3-5 CPU
+minutes with the bases cached (an uncached 40 kHz solve adds 1-2 CPU minutes).
 """
 
 import argparse
