@@ -67,6 +67,7 @@ class StructureSolveCost:
     solves: int
     memory_bytes: float
     time_s: float
+    factorise_s: float = 0.0  # one ordering and factorisation of K (the static compliance)
 
     def describe(self) -> str:
         """e.g. '~233 modes on 81 640 DOFs, ~75 M factor entries, ~490 solves'."""
@@ -120,7 +121,7 @@ def solve_cost(n_dofs: int, nnz: int, n_modes: int, extra: int = 0) -> Structure
     time_s = 2.0 * factorise + solves * per_solve
     vectors = 8.0 * n_dofs * (ncv + 2 * nev)  # Lanczos basis, returned modes and a copy
     memory = BASE_MEMORY + FACTOR_BYTES * (f + MATRIX_COPIES * nnz) + vectors
-    return StructureSolveCost(int(n_dofs), int(n_modes), f, solves, memory, time_s)
+    return StructureSolveCost(int(n_dofs), int(n_modes), f, solves, memory, time_s, factorise)
 
 
 def structure_cost(model, fmax_hz: float) -> StructureSolveCost:
