@@ -148,3 +148,28 @@ def test_a_total_names_the_parts_it_leaves_out():
     assert line.startswith("estimated cost without the eigen-solve (not estimated) ")
     whole = C.RunCost(parts[1:]).describe()
     assert whole.startswith("estimated cost ") and "without" not in whole
+
+
+def test_the_line_names_what_the_band_costs_and_what_half_of_it_would():
+    # no plate.fmax, a sensor of 20 kHz bandwidth: the band comes from the sensors, the
+    # line gives its bases' cost and half the band's, and the key that sets the band
+    text = 'duration = 0.05\n[plate]\nmodel = "modal"\n' + BALL + SENSOR.format(rate=51200.0)
+    scene = loads_scene(text.replace("bandwidth = 2000.0", "bandwidth = 20000.0"))
+    cost = run_cost(scene)
+    eigen = cost.part("eigen-solve")
+    assert eigen.driver.startswith("band 20 kHz from the sensors' bandwidth")
+    bases = f"the bases of 20 kHz ~{eigen.time_s:.0f} s; 10 kHz would take ~"
+    assert cost.alternative.startswith(bases) and cost.alternative.endswith(
+        " s for the bases: set sensors[i].bandwidth"
+    )
+    half = float(cost.alternative[len(bases) :].split(" ")[0])
+    assert half < eigen.time_s
+    assert cost.describe().endswith(cost.alternative)
+
+
+def test_the_load_stretch_is_the_load_over_the_cores(monkeypatch):
+    monkeypatch.setattr(C.os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(C.os, "getloadavg", lambda: (6.0, 5.0, 4.0))
+    assert C.load_stretch() == (3.0, 6.0, 2)
+    monkeypatch.setattr(C.os, "getloadavg", lambda: (0.5, 0.5, 0.5))
+    assert C.load_stretch()[0] == 1.0  # an idle machine: the estimate itself

@@ -5,8 +5,8 @@ per piece of work, each with its own model here and its time (s), peak memory (b
 drives it and whether it is already cached:
 
 - ``eigen-solve``: the modal basis of the band (DOFs counted on the mesh, modes by Weyl's
-  count, ``tailbeam.plate.fe.cost``): time EIGEN_TIME x N m^2 (shift-invert Lanczos
-  orthogonalises each new vector against ~1.5 m others), nothing if the basis is cached
+  count): the assembly, two factorisations and the shift-invert solves with their
+  orthogonalisation (``tailbeam.plate.fe.cost.solve_time``), nothing if the basis is cached
   (loading it: CACHE_LOAD_BYTES_PER_S);
 - ``contact tails``: a stream's wider basis to the tails' band on the band's own mesh, the
   same model;
@@ -25,28 +25,34 @@ drives it and whether it is already cached:
 - ``set-up`` (single balls): the band's contact pulses and, where ``plate.tail`` builds it,
   the Ritz tail's pre-pass (FE solves: DOF^1.5 per contact point).
 
-The constants were fitted on this project's 2-core machine, shared with other jobs, one
-BLAS thread, with ``benchmarks/bench_cost_model.py`` (its table is in docs/band-and-cost.md),
-between runs at load averages ~6 and ~10, where the same scenes took 2-3x longer. They
-estimate, they do not bound.
+Every time is the CPU time of one core (one BLAS thread): what the run takes on an idle
+machine; under load the wall time is longer by about the load average over the cores
+(``load_stretch``). The eigen-solves' rates are measured in CPU time
+(``tailbeam.plate.fe.cost``); the other constants were fitted to wall times of
+``benchmarks/bench_cost_model.py`` at load averages ~3-10 and checked against its CPU times
+at 14-19 (docs/band-and-cost.md's table); those marked (c) were set from those CPU times,
+where the wall-time fit was more than 2x off. They estimate, they do not bound.
 """
 
 import math
+import os
 from dataclasses import dataclass
 
 from tailbeam.errors import InputError
+from tailbeam.plate.fe.cost import solve_time
 
-EIGEN_TIME = 1.5e-8  # s / (DOF mode^2) of a Lanczos band solve, one BLAS thread
-EIGEN_BASE = 0.6  # s: assembling the FE model and factorising, per solve
 EIGEN_WORDS = 6.0  # doubles per DOF per mode held during the solve (and by a loaded basis)
 BASE_MEMORY = 2.0e8  # bytes: interpreter, numpy, scipy, numba
 MODAL_BASE_MEMORY = 3.0e8  # bytes: the same with the FE assembly and the modal kernels
 CACHE_LOAD_BYTES_PER_S = 5e8  # reading a cached basis (npz)
-SETUP_BASE = 0.02  # s: the band's contact pulses, building the basis' probes
+SETUP_BASE = 0.02  # s: building the basis' probes
+SETUP_PULSE = 0.01  # s per ball: its hardest impact's force pulse (the automatic band)
+STREAM_SETUP = 0.4  # s: a stream's modal set-up on cached bases (c: 0.34 and 0.55 s measured)
 RITZ_DOF_POINT = 5.5e-7  # s per DOF^1.5 and contact point: the Ritz tail's pre-pass (FE solves)
 COUPLED_BASE = 0.03  # s: a coupled run's set-up and result
 COUPLED_BALL = 0.066  # s per ball: its residual compliance (an FE load solve), its records
-COUPLED_STEP = 2.2e-9  # s per step, mode and ball^2 (single balls on the modal plate)
+COUPLED_STEP = 1.6e-9  # s per step, mode and ball^2 (single balls on the modal plate) (c)
+COUPLED_FACTOR = 4e-8  # s per DOF^1.5: factorising K for the residual compliance (c)
 COUPLED_STEP_BASE = 1.6e-6  # s per step
 COUPLED_OVERHEAD = 1.3  # steps per contact step: event location, flights
 RIGID_BASE = 0.01  # s
@@ -61,13 +67,13 @@ REFERENCE_STEPS_PER_CONTACT = 20
 REFERENCE_STEPS_PER_PARTICLE = 20
 REPLAY_BASE = 0.35  # s: importing scipy.signal, once
 REPLAY_SENSOR = 0.25  # s per sensor: its chain's filters
-REPLAY_SENSOR_MODE = 3e-3  # s per sensor and mode: the quasi-static correction there
-REPLAY_RITZ = 6e-7  # s per sensor and DOF^1.5: the Ritz tail's static part (FE solves)
+REPLAY_SENSOR_MODE = 6e-4  # s per sensor, mode and sqrt(balls): quasi-static correction (c)
+REPLAY_RITZ = 2e-8  # s per sensor and DOF^1.5: the Ritz tail's static part (FE solves) (c)
 REPLAY_SAMPLE_MODE = 1.0e-8  # s per fine sample and mode (modal response at the sensor)
 REPLAY_SAMPLE = 2.0e-7  # s per fine sample: resonance FFT, anti-alias filter, spectrum
-REPLAY_PARTICLE_MODE = 1.5e-4  # s per stream particle and mode: its loads' modal response
+REPLAY_PARTICLE_MODE = 3e-5  # s per stream particle and mode: its loads' modal response (c)
 REPLAY_WORDS = 12.0  # doubles held per fine sample (signal, padded FFT, filtered copies)
-WRITE_BASE = 0.03  # s: impacts.csv, particles.csv, impacts.json
+WRITE_BASE = 0.015  # s: impacts.csv, particles.csv, impacts.json (c)
 WRITE_VALUE = 1.8e-6  # s per CSV value written (numbers formatted by Python)
 PLOT_BASE = 1.2  # s: importing matplotlib, once, when a sensor is plotted
 FIGURE_BASE = 1.2  # s per figure
@@ -138,6 +144,19 @@ class RunCost:
         }  # fmt: skip
 
 
+def load_stretch() -> tuple:
+    """(stretch, load average, cores): how many times longer than the estimate (the CPU
+    time of one core, which the run gets whole on an idle machine) its wall time may be on
+    this machine now: the 1-minute load average over the cores, at least 1 (the run shares
+    the cores with that many running processes)."""
+    cores = os.cpu_count() or 1
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):  # not on every platform
+        return 1.0, 0.0, cores
+    return max(1.0, load / cores), load, cores
+
+
 def _seconds(t: float) -> str:
     return f"~{t:.0f} s" if t >= 10 else f"~{t:.1f} s"
 
@@ -151,23 +170,32 @@ def eigen_part(name: str, n_dofs: int, n_modes: int, cached_bytes: float | None,
     memory = MODAL_BASE_MEMORY + 8.0 * EIGEN_WORDS * n_dofs * n_modes
     if cached_bytes is not None:
         return Part(name, cached_bytes / CACHE_LOAD_BYTES_PER_S, memory, driver, cached=True)
-    return Part(name, EIGEN_BASE + EIGEN_TIME * n_dofs * n_modes**2, memory, driver)
+    return Part(name, solve_time(n_dofs, n_modes), memory, driver)
 
 
-def setup_part(n_dofs: int, ritz_points: int) -> Part:
-    """The rest of a single-ball modal set-up: the band's pulses, the basis' probes and, on
-    ``ritz_points`` contact points, the Ritz tail's pre-pass (an FE solve per vector)."""
-    time_s = SETUP_BASE + RITZ_DOF_POINT * n_dofs**1.5 * ritz_points
+def setup_part(n_dofs: int, ritz_points: int, pulses: int = 0) -> Part:
+    """The rest of a single-ball modal set-up: the band's ``pulses`` (one per ball when the
+    band is chosen automatically), the basis' probes and, on ``ritz_points`` contact
+    points, the Ritz tail's pre-pass (an FE solve per vector)."""
+    time_s = SETUP_BASE + SETUP_PULSE * pulses + RITZ_DOF_POINT * n_dofs**1.5 * ritz_points
     what = f"Ritz tail at {ritz_points} points" if ritz_points else "quasi-static tail"
     return Part("set-up", time_s, MODAL_BASE_MEMORY, what)
 
 
-def coupled_part(impacts: float, n_balls: int, n_modes: int, steps_per_contact: int) -> Part:
-    """Single balls on the modal plate: ``impacts`` contacts of ``steps_per_contact`` steps."""
+def stream_setup_part() -> Part:
+    """The rest of a stream's modal set-up: its band's check, the bases' probes."""
+    return Part("set-up", STREAM_SETUP, MODAL_BASE_MEMORY, "stream")
+
+
+def coupled_part(impacts: float, n_balls: int, n_modes: int, steps_per_contact: int,
+                 fe_dofs: int = 0) -> Part:  # fmt: skip
+    """Single balls on the modal plate: ``impacts`` contacts of ``steps_per_contact`` steps;
+    ``fe_dofs``: the flat plate's FE DOFs, factorised for the residual compliance (0: none)."""
     steps = COUPLED_OVERHEAD * impacts * steps_per_contact
     per_step = COUPLED_STEP_BASE + COUPLED_STEP * n_modes * max(n_balls, 1) ** 2
     memory = MODAL_BASE_MEMORY + 8.0 * steps * (1 + 4 * n_balls)  # the recorded nodes
     time_s = COUPLED_BASE + COUPLED_BALL * n_balls + steps * per_step
+    time_s += COUPLED_FACTOR * fe_dofs**1.5
     return Part("simulation", time_s, memory,
                 f"{impacts:.0f} impacts x {steps_per_contact} steps, {n_modes} modes")  # fmt: skip
 
@@ -198,13 +226,15 @@ def reference_part(n_particles: int, impacts: float) -> Part:
 
 
 def replay_part(sensors, duration: float, n_modes: int, top_hz: float, particles: int = 0,
-                ritz_dofs: int = 0):  # fmt: skip
+                ritz_dofs: int = 0, balls: int = 0):  # fmt: skip
     """Every sensor's chain on its fine grid (``tailbeam.signals.sensor.measure``); a stream's
     ``particles``: the modal response to their recorded loads; ``ritz_dofs``: the FE model's
-    DOFs when the basis carries the Ritz tail (its static part at each sensor)."""
+    DOFs when the basis carries the Ritz tail (its static part at each sensor); ``balls``:
+    the single balls whose contact forces the quasi-static correction reads."""
     fines = [_fine_samples(s, duration, top_hz) for s in sensors]
     per = REPLAY_SAMPLE + REPLAY_SAMPLE_MODE * n_modes
-    per_sensor = REPLAY_SENSOR + REPLAY_SENSOR_MODE * n_modes + REPLAY_RITZ * ritz_dofs**1.5
+    per_sensor = REPLAY_SENSOR + REPLAY_SENSOR_MODE * n_modes * math.sqrt(max(balls, 1))
+    per_sensor += REPLAY_RITZ * ritz_dofs**1.5
     time_s = REPLAY_BASE + per_sensor * len(sensors) + per * sum(fines)
     time_s += REPLAY_PARTICLE_MODE * particles * n_modes
     memory = MODAL_BASE_MEMORY + 8.0 * REPLAY_WORDS * max(fines, default=0)

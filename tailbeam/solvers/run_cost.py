@@ -11,6 +11,7 @@ from tailbeam.solvers.cost import (
     RunCost,
     check_replay,
     coupled_part,
+    load_stretch,
     reference_part,
     replay_part,
     rigid_part,
@@ -79,8 +80,9 @@ def estimate_run(scene, solver, *, band: dict | None = None, writes: bool = True
         check_replay(scene, n_modes, top_hz)
         particles = len(scene.particles) if solver.stream else 0
         ritz_dofs = plan.n_dofs if plan.ritz_points else 0
+        balls = 0 if solver.stream else len(scene.balls)
         parts.append(replay_part(scene.sensors, scene.duration, n_modes, top_hz, particles,
-                                 ritz_dofs))  # fmt: skip
+                                 ritz_dofs, balls))  # fmt: skip
     if writes:
         parts.append(write_part(scene, not solver.stream, modal_sensors))
     return RunCost(tuple(parts), alternative)
@@ -95,13 +97,21 @@ def _simulation(scene, solver, n_modes: int, plan):
         return stream_part(len(scene.particles), n_modes, plan.tail_oscillators)
     if scene.plate_model == "rigid":
         return rigid_part(expected_impacts(scene))
+    settings = scene.modal
+    flexible = settings is None or (settings.residual_flexibility and settings.mesh is None)
     return coupled_part(expected_impacts(scene), len(scene.balls), n_modes,
-                        DEFAULT_STEPS_PER_CONTACT)  # fmt: skip
+                        DEFAULT_STEPS_PER_CONTACT, plan.n_dofs if flexible else 0)  # fmt: skip
 
 
 def announce_run(scene, solver) -> RunCost:
     """Estimate the run (``estimate_run``, which refuses what is beyond the limits) and say
-    the estimate on stderr, before any work."""
+    the estimate on stderr, before any work, with the stretch of the machine's current load
+    (``cost.load_stretch``) when it is 1.5 or more."""
     cost = estimate_run(scene, solver)
-    note(cost.describe())
+    stretch, load, cores = load_stretch()
+    busy = ""
+    if stretch >= 1.5:
+        busy = (f"; on this machine's load ({load:.1f} on {cores} cores) the wall time may be "
+                f"~{stretch:.1f}x that")  # fmt: skip
+    note(cost.describe() + busy)
     return cost

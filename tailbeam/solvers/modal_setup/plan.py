@@ -22,9 +22,10 @@ from tailbeam.plate.fe.mindlin import DEFAULT_DEGREE
 from tailbeam.plate.fe.model import resolve_mesh
 from tailbeam.plate.fe.modes import _estimated_count
 from tailbeam.plate.fe.resolution import resolve
+from tailbeam.plate.solid.cost import structure_cost
 from tailbeam.plate.solid.held import held_structure
 from tailbeam.scene import ModalPlateSettings
-from tailbeam.solvers.cost import Part, eigen_part, setup_part
+from tailbeam.solvers.cost import Part, eigen_part, setup_part, stream_setup_part
 from tailbeam.solvers.modal_setup.band import (
     BAND_GRID_HZ,
     STREAM_MIN_BAND_HZ,
@@ -84,8 +85,8 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
                                 f"modes to {wide / 1e3:g} kHz"))  # fmt: skip
         tail_k = int(band.get("tail_oscillators", 0))
     ritz = 0 if stream else _ritz_points(scene, settings, theory)
-    if not stream:
-        parts.append(setup_part(dofs, ritz))
+    pulses = 0 if band.get("user_fmax") else len(scene.balls)
+    parts.append(stream_setup_part() if stream else setup_part(dofs, ritz, pulses))
     two_way = settings.coupling == "two-way"
     return BasisPlan(tuple(parts), modes, fmax, two_way, tail_k,
                      _alternative(scene, settings, band, stream, parts), dofs, ritz)  # fmt: skip
@@ -103,19 +104,20 @@ def check_structure_solver(settings, stream: bool) -> None:
 
 
 def _structure_plan(scene, settings, band: dict) -> BasisPlan:
-    """A structure from plate.mesh: its DOFs are known (the scene reader built it), the cost
-    of its modes is not estimated (no model of a solid's mode count and factor fill yet);
-    the modes the simulation and replay are costed with are the impact face's flat plate's
-    Weyl count, a floor for a structure with ribs and walls below the face."""
+    """A structure from plate.mesh: its DOFs and matrices are known (the scene reader built
+    it); its eigen-solve is estimated from them (``tailbeam.plate.solid.cost``), and the
+    simulation and replay are costed with that estimate's modes."""
     fmax = band["fmax_hz"]
     model = held_structure(settings.mesh, settings.impact_face, settings.supports,
                            scene.plate.material)  # fmt: skip
-    driver = (f"structure from plate.mesh, {model.n_dofs} DOFs, band {fmax / 1e3:g} kHz: "
-              "cost of the structure's modes not estimated, not cached")  # fmt: skip
-    modes = _estimated_count(scene.plate, parse_boundary("CCCC"), "mindlin", fmax)
-    parts = (Part("eigen-solve", 0.0, 0.0, driver, estimated=False),
-             setup_part(model.n_dofs, 0))  # fmt: skip
-    return BasisPlan(parts, modes, fmax, settings.coupling == "two-way", 0, "", model.n_dofs, 0)
+    cost = structure_cost(model, fmax)
+    driver = (f"structure from plate.mesh, band {fmax / 1e3:g} kHz from "
+              f"{_why(band, False)}: {cost.describe()}, not cached")  # fmt: skip
+    static = Part("set-up", cost.factorise_s, cost.memory_bytes,
+                  "the static compliance: one factorisation")  # fmt: skip
+    parts = (Part("eigen-solve", cost.time_s, cost.memory_bytes, driver), static)
+    return BasisPlan(parts, cost.n_modes, fmax, settings.coupling == "two-way", 0, "",
+                     model.n_dofs, 0)  # fmt: skip
 
 
 def _ritz_points(scene, settings, theory: str) -> int:
@@ -178,4 +180,6 @@ def _alternative(scene, settings, band, stream, parts) -> str:
     if stream and band.get("tail_band_hz"):
         cost *= 1.0 + solves[1].time_s / max(solves[0].time_s, 1e-9)  # the tails scale alike
     key = "sensors[i].bandwidth" if _why(band, stream).startswith("the sensors") else "plate.fmax"
-    return f"{half / 1e3:g} kHz would take ~{cost:.0f} s for the bases: set {key}"
+    now = sum(p.time_s for p in solves)
+    return (f"the bases of {band['fmax_hz'] / 1e3:g} kHz ~{now:.0f} s; {half / 1e3:g} kHz would "
+            f"take ~{cost:.0f} s for the bases: set {key}")  # fmt: skip
