@@ -219,3 +219,18 @@ def test_new_keys_round_trip_through_the_dump(structure):
 def test_library_refuses_a_zero_direction():
     with pytest.raises(InputError, match=r"sensors\[s\]\.direction"):
         SensorSpec("s", (0.0, 0.0), direction=(0.0, 0.0, 0.0))
+
+
+def test_a_sweep_refuses_a_sensor_with_axes_before_any_case_runs():
+    from tailbeam.study.design import expand, parse_sweep
+
+    scene = {
+        "duration": 0.01,
+        "plate": {"model": "modal", "fmax": 3000.0},
+        "balls": [{"name": "rock", "material": "coal", "radius": 0.02,
+                   "position": [0.0, 0.0, 0.06], "velocity": [0.0, 0.0, -1.0]}],
+        "sensors": [{"name": "S1", "position": [0.1, 0.1], "axes": "z"}],
+    }  # fmt: skip
+    spec = parse_sweep({"scene": scene, "axes": {"balls[1].radius": [0.02, 0.03]}})
+    with pytest.raises(InputError, match=r"scene\.sensors\[1\]\.axes"):
+        expand(spec)
