@@ -134,7 +134,7 @@ def small(tmp_path_factory):
 
 
 SUPPORT = '[[plate.supports]]\ngroup = "sides"\nkind = "clamped"\n'
-SENSOR_3D = '[[sensors]]\nname = "back"\nposition = [0.0, 0.0, -0.01]\n'
+SENSOR_3D = '[[sensors]]\nname = "back"\nposition = [0.0, 0.0, -0.005]\n'  # inside: off the surface
 SECOND_BALL = BALL.replace('"b"', '"c"').replace("0.05, 0.0", "0.06, 0.0")  # may touch b
 BAD = {  # case: (text replaced, by, field named), "" replaced: appended
     "unreadable": ("plate.msh", "junk.msh", "plate.mesh"),

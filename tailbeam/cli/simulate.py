@@ -83,7 +83,8 @@ def write_results(out_dir, scene, result) -> list:
         files.append(write_timeseries_csv(out_dir / "timeseries.csv", result, scene.sample_rate))
     if scene.sensors and result.plate_model == "modal":
         n = len(scene.sensors)
-        with task(f"sensor replay and outputs, {n} sensors", total=n + 1, unit="steps") as bar:
+        steps = sum(len(s.channels()) for s in scene.sensors) + 1  # the replay, then a figure each
+        with task(f"sensor replay and outputs, {n} sensors", total=steps, unit="steps") as bar:
             outputs = result.sensor_outputs  # the exact plate response through each chain
             bar.update(1)
             files += _write_sensors(out_dir, scene, result, outputs, bar)
@@ -94,14 +95,7 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
     from tailbeam.io.results_io import write_sensor_spectra_csv, write_sensors_csv
     from tailbeam.signals.figures import sensor_figure
 
-    meta = {
-        s.name: {
-            "position_m": list(s.position),
-            "sample_rate_hz": outputs[s.name].chain.sample_rate,
-            "bandwidth_hz": outputs[s.name].chain.bandwidth_hz,
-        }
-        for s in scene.sensors
-    }
+    meta = {c.name: _sensor_meta(c, outputs[c.name]) for s in scene.sensors for c in s.channels()}
     files = [
         describe(
             write_sensors_csv(out_dir / "sensors.csv", result.sensor_signals),
@@ -116,9 +110,22 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
     ]
     for name, out in outputs.items():
         position = tuple(meta[name]["position_m"])
-        files.append(sensor_figure(out, out_dir / f"sensor_{name}.png", position=position))
+        direction = meta[name].get("direction")
+        files.append(sensor_figure(out, out_dir / f"sensor_{name}.png", position=position,
+                                   direction=direction))  # fmt: skip
         bar.update(1)
     return files
+
+
+def _sensor_meta(channel, output) -> dict:
+    """The manifest's entry of one sensor signal: position (m), direction (unit, plate frame;
+    only for a sensor given a direction or axes), sample rate and bandwidth (Hz)."""
+    meta = {"position_m": list(channel.position)}
+    if channel.direction is not None:
+        meta["direction"] = list(channel.direction)
+    meta["sample_rate_hz"] = output.chain.sample_rate
+    meta["bandwidth_hz"] = output.chain.bandwidth_hz
+    return meta
 
 
 def vtk_frames(args, scene, solver):

@@ -92,6 +92,10 @@ def scene_to_dict(scene: Scene) -> dict:
             n = s.noise
             d["noise"] = {"rms": n.rms, "background": n.background, "band": list(n.band_hz)}
             d["noise"]["seed"] = n.seed
+        if s.direction is not None:
+            d["direction"] = list(s.direction)
+        if s.axes is not None:
+            d["axes"] = s.axes
         sensors.append(d)
     if sensors:
         out["sensors"] = sensors

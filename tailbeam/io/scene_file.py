@@ -80,7 +80,9 @@ FLAT_ONLY = ("size", "boundary", "theory", "mesh_divisions")  # the flat plate's
 FREE_HINT = "add supports, or ask for a free structure"  # the library's words, not a scene's
 SUPPORT_KEYS = ("kind", "group", "region", "stiffness", "direction", "axis")
 BALL_KEYS = ("name", "material", "radius", "position", "velocity", "label", "angular_velocity")
-SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance", "noise")
+SENSOR_KEYS = ("name", "position", "sample_rate", "bandwidth", "mounted_resonance", "noise",
+               "direction", "axes")  # fmt: skip
+FLAT_SURFACE_TOLERANCE = 1e-3  # of the thickness: a flat plate's point (x, y, z) off a face
 NOISE_KEYS = ("rms", "background", "band", "seed")
 REQUIRED = ("duration", "balls")  # or duration and streams
 
@@ -129,7 +131,7 @@ def parse_scene(data: dict, *, base_dir=None) -> Scene:
     duration = require_positive("duration", data["duration"])
     balls, labels = _parse_balls(data.get("balls", []), materials, plate, "streams" in data)
     streams = _parse_streams(data.get("streams", []), incline, materials)
-    sensors = _parse_sensors(data.get("sensors", []), plate)
+    sensors = _parse_sensors(data.get("sensors", []), plate, modal)
     if sensors and model != "modal":
         raise InputError("sensors", "need plate.model = 'modal' (a rigid plate does not vibrate)")
     if "sample_rate" in data:
@@ -415,7 +417,7 @@ def _metres_hint(x: float, y: float, plate: Plate) -> str:
     return ""
 
 
-def _parse_sensors(value, plate: Plate) -> tuple:
+def _parse_sensors(value, plate: Plate, modal: ModalPlateSettings | None = None) -> tuple:
     from tailbeam.signals.sensor import (
         resolve,  # scipy.signal: imported only for scenes with sensors
     )
@@ -430,15 +432,6 @@ def _parse_sensors(value, plate: Plate) -> tuple:
                 f"{field}.name",
                 f"{name!r} may hold only letters, digits and _ . + - (it names output files)",
             )
-        if isinstance(t["position"], list) and len(t["position"]) == 3:
-            raise InputError(
-                f"{field}.position",
-                "a point (x, y, z) on a structure's surface is not supported yet; give (x, y) "
-                "m on the impact face (read along its normal)",
-            )
-        x, y = require_vector(f"{field}.position", t["position"], 2)
-        if not plate.contains(x, y):
-            raise InputError(f"{field}.position", f"({x!r}, {y!r}) m is not on the plate")
         kwargs = {}
         for key, arg in (
             ("sample_rate", "sample_rate"),
@@ -449,16 +442,65 @@ def _parse_sensors(value, plate: Plate) -> tuple:
                 kwargs[arg] = require_real(f"{field}.{key}", t[key])
         if "noise" in t:
             kwargs["noise"] = _parse_noise(f"{field}.noise", t["noise"])
+        if "direction" in t:
+            kwargs["direction"] = t["direction"]
+        if "axes" in t:
+            kwargs["axes"] = t["axes"]
         try:
-            sensors.append(SensorSpec(name, (x, y), **kwargs))
+            sensors.append(SensorSpec(name, t["position"], **kwargs))
             resolve(sensors[-1])  # the chain's own rules (mounted resonance above the band)
         except InputError as err:  # SensorSpec names itself sensors[<name>]; the file counts
             raise InputError(err.field.replace(f"sensors[{name}]", field), err.rule) from None
-    names = [s.name for s in sensors]
-    for i, name in enumerate(names, start=1):
-        if name in names[: i - 1]:
-            raise InputError(f"sensors[{i}].name", f"{name!r} is used by an earlier sensor")
+        _check_sensor_place(field, sensors[-1], plate, modal)
+    _check_sensor_names(sensors)
     return tuple(sensors)
+
+
+def _check_sensor_names(sensors) -> None:
+    """Sensor names, and the signal names of their axes (``<name>_x``...), are unique."""
+    seen = set()
+    for i, s in enumerate(sensors, start=1):
+        if s.name in seen:
+            raise InputError(f"sensors[{i}].name", f"{s.name!r} is used by an earlier sensor")
+        for c in s.channels():
+            if c.name in seen:
+                raise InputError(
+                    f"sensors[{i}].name", f"signal {c.name!r} is named by an earlier sensor"
+                )
+            seen.add(c.name)
+        seen.add(s.name)
+
+
+def _check_sensor_place(field: str, spec: SensorSpec, plate: Plate, modal) -> None:
+    """A sensor's point lies on the plate or structure; on the flat plate a point (x, y, z)
+    lies on its top (z = 0) or bottom (z = -thickness) face and reads along the normal."""
+    x, y = spec.position[:2]
+    structure = modal is not None and modal.mesh is not None
+    if len(spec.position) == 3 and structure:
+        model = held_structure(modal.mesh, modal.impact_face, modal.supports, plate.material)
+        model.surface().locate([spec.position], f"{field}.position")
+        return
+    if not plate.contains(x, y):
+        raise InputError(f"{field}.position", f"({x!r}, {y!r}) m is not on the plate")
+    if len(spec.position) == 3:
+        z, h = spec.position[2], plate.thickness
+        off = min(abs(z), abs(z + h))
+        if off > FLAT_SURFACE_TOLERANCE * h:
+            raise InputError(
+                f"{field}.position",
+                f"z = {z!r} m is {off:.3g} m off the flat plate's surface: give its top face "
+                f"z = 0 or its bottom face z = {-h!r} m",
+            )
+    if structure:
+        return
+    directions = [c.direction for c in spec.channels() if c.direction is not None]
+    if any(abs(d[0]) > 0 or abs(d[1]) > 0 for d in directions):
+        key = "axes" if spec.axes is not None else "direction"
+        raise InputError(
+            f"{field}.{key}",
+            "the flat plate is read along its normal only (direction (0, 0, +-1), axes 'z'); "
+            "other directions need a structure from plate.mesh",
+        )
 
 
 def _parse_noise(field: str, value) -> NoiseSpec:

@@ -151,14 +151,15 @@ def _spectrogram_panel(fig, ax, output, stats, f_max):
     )
 
 
-def sensor_figure(output, path, *, position=None) -> Path:
-    """Write build_sensor_figure(output, position) to ``path`` (PNG); returns the path."""
+def sensor_figure(output, path, *, position=None, direction=None) -> Path:
+    """Write build_sensor_figure(output, position, direction) to ``path`` (PNG); returns the
+    path."""
     path = Path(path)
-    build_sensor_figure(output, position).savefig(path, dpi=110)
+    build_sensor_figure(output, position, direction).savefig(path, dpi=110)
     return path
 
 
-def build_sensor_figure(output, position=None) -> Figure:
+def build_sensor_figure(output, position=None, direction=None) -> Figure:
     """One sensor's record as a 2 x 2 figure: acceleration against time (peak and RMS marked),
     the whole-record amplitude spectrum (with its resolution fs/N), a Welch PSD and a
     spectrogram, all up to the sensor's usable bandwidth.
@@ -167,8 +168,10 @@ def build_sensor_figure(output, position=None) -> Figure:
     ----------
     output : tailbeam.signals.sensor.SensorOutput
         The sampled record (m/s^2) and the chain that produced it.
-    position : (x, y) in m, optional
-        The sensor's position on the plate, written in the title.
+    position : (x, y) or (x, y, z) in m, optional
+        The sensor's position on the plate or structure, written in the title.
+    direction : (dx, dy, dz), optional
+        The sensor's measuring direction (unit, plate frame), written in the title.
 
     Returns
     -------
@@ -196,7 +199,7 @@ def build_sensor_figure(output, position=None) -> Figure:
             )
     for ax in (ax_t, ax_f, ax_w):
         ax.grid(alpha=0.3)
-    where = "" if position is None else f" at (x, y) = ({position[0]:g}, {position[1]:g}) m"
+    where = _where(position, direction)
     fig.suptitle(
         f"sensor {output.name}{where}: fs = {chain.sample_rate:g} Hz, usable band to "
         f"{chain.bandwidth_hz:g} Hz (plots stop there), mounted resonance "
@@ -204,6 +207,17 @@ def build_sensor_figure(output, position=None) -> Figure:
         fontsize=10,
     )
     return fig
+
+
+def _where(position, direction) -> str:
+    """' at (x, y) = (..) m' (and ' along (..)') for a figure's title."""
+    if position is None:
+        return ""
+    names = "(x, y)" if len(position) == 2 else "(x, y, z)"
+    where = f" at {names} = ({', '.join(f'{v:g}' for v in position)}) m"
+    if direction is not None:
+        where += f" along ({', '.join(f'{v:.3g}' for v in direction)})"
+    return where
 
 
 def sensor_figures(outputs: dict, out_dir, positions: dict | None = None) -> list:

@@ -22,7 +22,7 @@ rule) with damping ratio 0.03 (Q ~ 17, typical of stud-mounted piezoelectric sen
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -35,24 +35,33 @@ RESONANCE_DAMPING = 0.03
 STOPBAND_DB = 90.0
 
 
+AXES = "xyz"  # the letters of ``axes``, one per axis of the plate frame
+
+
 @dataclass(frozen=True)
 class SensorSpec:
-    """An accelerometer on the plate, measuring acceleration normal to it (m/s^2).
+    """An accelerometer on the plate or structure, measuring acceleration (m/s^2).
 
-    position (x, y) in m; sample_rate in Hz; bandwidth_hz: upper edge of the usable band
-    (None: chosen from the sample rate); mounted_resonance_hz (None: chosen from the bandwidth).
+    position: (x, y) m, a point of the impact face; or (x, y, z) m, a point of the surface
+    (plate frame: the impact face is z = 0, the structure lies below it). direction: (dx, dy,
+    dz) the measuring axis (normalised here; None: the impact face's normal +z); axes: a
+    subset of "xyz" in any order, one signal per axis (``channels``), or None. sample_rate in
+    Hz; bandwidth_hz: upper edge of the usable band (None: chosen from the sample rate);
+    mounted_resonance_hz (None: chosen from the bandwidth).
     """
 
     name: str
-    position: tuple[float, float]
+    position: tuple
     sample_rate: float = 51200.0
     bandwidth_hz: float | None = None
     mounted_resonance_hz: float | None = None
     noise: NoiseSpec | None = None  # measurement noise added to the output (tailbeam.signals.noise)
+    direction: tuple | None = None
+    axes: str | None = None
 
     def __post_init__(self):
         field_ = f"sensors[{self.name}]"
-        object.__setattr__(self, "position", require_vector(f"{field_}.position", self.position, 2))
+        object.__setattr__(self, "position", _position(f"{field_}.position", self.position))
         object.__setattr__(
             self, "sample_rate", require_positive(f"{field_}.sample_rate", self.sample_rate)
         )
@@ -70,6 +79,58 @@ class SensorSpec:
                 "mounted_resonance_hz",
                 require_positive(f"{field_}.mounted_resonance", self.mounted_resonance_hz),
             )
+        self._check_direction(field_)
+
+    def _check_direction(self, field_: str) -> None:
+        if self.direction is not None and self.axes is not None:
+            raise InputError(f"{field_}.axes", "give direction or axes, not both")
+        if self.direction is not None:
+            d = np.array(require_vector(f"{field_}.direction", self.direction, 3))
+            norm = float(np.linalg.norm(d))
+            if not norm > 0.0:
+                raise InputError(f"{field_}.direction", "must be a nonzero (dx, dy, dz) vector")
+            object.__setattr__(self, "direction", tuple(float(v) for v in d / norm))
+        if self.axes is not None:
+            axes = self.axes
+            if (
+                not isinstance(axes, str)
+                or not axes
+                or any(a not in AXES for a in axes)
+                or len(set(axes)) != len(axes)
+            ):
+                raise InputError(
+                    f"{field_}.axes",
+                    f"must be distinct letters of {AXES!r} (e.g. 'xyz', 'z'), got {axes!r}",
+                )
+
+    @property
+    def plain(self) -> bool:
+        """True for a point (x, y) of the impact face read along +z (no direction, no axes)."""
+        return len(self.position) == 2 and self.direction is None and self.axes is None
+
+    def channels(self) -> tuple:
+        """One single-direction SensorSpec per output signal: itself, or with ``axes`` one per
+        letter named ``<name>_<letter>`` along that axis (its noise drawn for that name)."""
+        if self.axes is None:
+            return (self,)
+        unit = {a: tuple(float(a == b) for b in AXES) for a in AXES}
+        return tuple(
+            replace(self, name=f"{self.name}_{a}", direction=unit[a], axes=None) for a in self.axes
+        )
+
+
+def _position(field: str, value) -> tuple:
+    """(x, y) or (x, y, z) m, finite."""
+    try:
+        n = len(value)
+    except TypeError:
+        n = 0
+    return require_vector(field, value, 3 if n == 3 else 2)
+
+
+def channel_names(sensors) -> list:
+    """The output signal names of ``sensors`` (``SensorSpec.channels``), in order."""
+    return [c.name for s in sensors for c in s.channels()]
 
 
 @dataclass(frozen=True)

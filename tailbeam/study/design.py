@@ -157,6 +157,7 @@ def expand(spec: SweepSpec) -> list:
                 first = shape
                 if not scene.sensors:
                     raise InputError("scene.sensors", "a sweep needs at least one [[sensors]]")
+                _check_plain_sensors(scene.sensors)
             elif shape != first:
                 raise InputError(
                     f"case {len(cases) + 1}",
@@ -165,3 +166,15 @@ def expand(spec: SweepSpec) -> list:
                 )
             cases.append(case)
     return cases
+
+
+def _check_plain_sensors(sensors) -> None:
+    """A dataset's sensors are points (x, y) read along z: InputError naming the first other."""
+    for i, s in enumerate(sensors, start=1):
+        if not s.plain:
+            key = "axes" if s.axes is not None else "direction" if s.direction else "position"
+            raise InputError(
+                f"scene.sensors[{i}].{key}",
+                "a sweep's dataset holds sensors at (x, y) read along z; a point (x, y, z), "
+                "direction or axes is not supported in sweeps",
+            )

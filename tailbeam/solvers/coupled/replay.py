@@ -12,6 +12,7 @@ import numpy as np
 
 from tailbeam.signals.sensor import measure
 from tailbeam.solvers.plate_loads.propagator import replay
+from tailbeam.solvers.plate_loads.readings import Readings
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,16 +145,34 @@ class ModalReplay:
             and getattr(self.basis, "static_deflection_at", None) is not None
         )
 
-    def quasi_static_sample(self, times, points) -> dict:
+    def channel_sample(self, times, channels, *, quasi_static: bool = True) -> dict:
+        """As ``sample``, at sensor channels (single-direction SensorSpecs: any surface point
+        and direction, ``tailbeam.solvers.plate_loads.readings``) instead of points."""
+        readings = Readings(self.basis, channels)
+        w, v, a = self._replay(times, np.ascontiguousarray(readings.shapes(), dtype=float))
+        if quasi_static and self.has_quasi_static:
+            qs = self.quasi_static_sample(times, channels, cross=readings.residual_cross)
+            w, v, a = w + qs["w"], v + qs["v"], a + qs["a"]
+        return {"w": w, "v": v, "a": a}
+
+    def quasi_static_sample(self, times, points, *, cross=None) -> dict:
         """The truncated modes' quasi-static (mode-acceleration) response at points (p, 2) m:
         w = -G_res F(t) (F pushes the plate down), G_res the residual cross compliance between
         the ball's contact and each point (ModalBasis.residual_cross_compliance, with the
         contact's load model).
         v and a are its central differences over +-h: h is the spacing of uniform ``times``
         (so a sampled record is the exact second difference of the sampled force: gain
-        sinc^2(f h), no aliasing of the force's kinks), else 1/(8 f_top). Arrays (p, len)."""
+        sinc^2(f h), no aliasing of the force's kinks), else 1/(8 f_top). Arrays (p, len).
+        ``cross`` (load point (2,), radius -> (p,)) replaces the residual cross compliance
+        at points by that of sensor channels (``Readings.residual_cross``; ``points`` then
+        lists the channels)."""
         t = np.atleast_1d(np.asarray(times, dtype=float))
-        points = np.atleast_2d(np.asarray(points, dtype=float))
+        if cross is None:
+            points = np.atleast_2d(np.asarray(points, dtype=float))
+
+            def cross(point, r):
+                return self._cross_compliance(point[0], point[1], r, points)
+
         out = {k: np.zeros((len(points), len(t))) for k in ("w", "v", "a")}
         h = _difference_step(t, float(np.max(self.basis.frequencies_hz)))
         tn, _z, _v, fn, _d = self.nodes
@@ -170,7 +189,7 @@ class ModalReplay:
                 sel = which == k
                 if not sel.any():
                     continue
-                g = -self._cross_compliance(x, y, r, points)  # the ball pushes the plate down
+                g = -np.asarray(cross((x, y), r))  # the ball pushes the plate down
                 for key, part in zip(("w", "v", "a"), parts, strict=True):
                     out[key][:, sel] += g[:, None] * part[sel]
         return out
@@ -194,13 +213,18 @@ class ModalReplay:
 
     def sensor_outputs(self, sensors, duration: float) -> dict:
         """name -> ``tailbeam.signals.sensor.SensorOutput`` of each ``SensorSpec`` of
-        ``sensors`` over [0, duration] s."""
+        ``sensors`` over [0, duration] s, one per channel (``SensorSpec.channels``)."""
         top = float(np.max(self.basis.frequencies_hz))
-        return {
-            s.name: measure(s, lambda t, p=s.position: self.acceleration(p, t), duration,
-                            max_frequency_hz=top)
-            for s in sensors
-        }  # fmt: skip
+        out = {}
+        for s in sensors:
+            if s.plain:
+                out[s.name] = measure(s, lambda t, p=s.position: self.acceleration(p, t),
+                                      duration, max_frequency_hz=top)  # fmt: skip
+                continue
+            for c in s.channels():
+                out[c.name] = measure(c, lambda t, c=c: self.channel_sample(t, [c])["a"][0],
+                                      duration, max_frequency_hz=top)  # fmt: skip
+        return out
 
 
 def _difference_step(t, f_top):

@@ -100,7 +100,7 @@ def _check_inputs(balls, basis, laws, sensors, residual_flexibility, coupling, s
     if int(steps_per_contact) < 4:
         raise InputError("steps_per_contact", "must be >= 4")
     for spec in sensors:
-        if not basis.plate.contains(*spec.position):
+        if len(spec.position) == 2 and not basis.plate.contains(*spec.position):
             raise InputError(f"sensors[{spec.name}].position", "must lie on the plate")
     if residual_flexibility and basis.static_compliance_at is None and coupling == "two-way":
         raise InputError(

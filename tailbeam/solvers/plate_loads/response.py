@@ -34,6 +34,7 @@ from tailbeam.solvers.plate_loads.kernel import (
     transition,
 )
 from tailbeam.solvers.plate_loads.loads import PlateLoads
+from tailbeam.solvers.plate_loads.readings import Readings
 
 BATCH_NODES = 4096  # load nodes per batch (bounds the mode-shape table: batch x modes)
 DISC_BATCH = 256  # load discs evaluated per basis call (48 points each)
@@ -56,6 +57,7 @@ def plate_response(
     batch_nodes: int = BATCH_NODES,
     max_bytes: float = MAX_BYTES,
     modal: bool = False,
+    readings=None,
 ) -> dict:
     """Plate deflection "w" (m, + up), velocity "v" (m/s) and acceleration "a" (m/s^2) at
     ``points`` under ``loads``, each (p, len(times)); with ``modal`` the kept modes'
@@ -90,10 +92,15 @@ def plate_response(
         0: every node at its own time (exact to rounding; slower with many nodes per sample).
     batch_nodes, max_bytes : int, float
         Load nodes per batch of mode shapes; memory bound (bytes, WorkLimitError above it).
+    readings : Readings, optional
+        Observe these sensor channels (``tailbeam.solvers.plate_loads.readings``: any surface
+        point and direction) instead of the deflection at ``points`` (then ignored).
     """
     omega = np.ascontiguousarray(basis.omega, dtype=float)
     if modal:  # the identity as the "shapes at the points": the outputs are q, q', q''
         pts, phi_pts, quasi_static = None, np.eye(omega.shape[0]), False
+    elif readings is not None:
+        pts, phi_pts = None, np.ascontiguousarray(readings.shapes(), dtype=float)
     else:
         pts = check_points(basis.plate, points, "points")
         phi_pts = np.ascontiguousarray(basis.deflection(pts), dtype=float)
@@ -111,7 +118,7 @@ def plate_response(
                             what)  # fmt: skip
     r = np.zeros_like(g)
     if quasi_static:
-        r = _residual(basis, xyr, pts, seen, g)
+        r = _residual(basis, xyr, pts, seen, g, readings)
     _add_particular_all(loads, nodes, t0, dt, g, h, r, out)
     return dict(zip(("w", "v", "a"), out, strict=True))
 
@@ -256,24 +263,28 @@ def disc_average(plate, xyr, evaluate) -> np.ndarray:
     return np.ascontiguousarray(out[inv.ravel()])
 
 
-def _residual(basis, xyr, pts, seen, g) -> np.ndarray:
+def _residual(basis, xyr, pts, seen, g, readings=None) -> np.ndarray:
     """R (pieces, p): the residual cross compliance (m/N) between each seen piece's load and
     the points: the full model's static deflection minus the kept modes' part g (as
     ModalBasis.residual_cross_compliance). The static part is taken by Maxwell-Betti
     reciprocity as the deflection at the load (disc-averaged) under a unit point load at
     each point: p static solutions, evaluated at the load points in batches. Zeros (with a
     note) if the basis has no static deflection; WorkLimitError if the estimated time (from
-    the first batch) exceeds MAX_QUASI_STATIC_S."""
-    r = np.zeros((xyr.shape[0], pts.shape[0]))
+    the first batch) exceeds MAX_QUASI_STATIC_S. With ``readings`` the points are its
+    channels and the static part is theirs (``Readings.static``)."""
+    r = np.zeros_like(g)
     if getattr(basis, "static_deflection_at", None) is None:
         note(f"no quasi-static correction: the {basis.theory} basis has no static deflection")
         return r
     idx = np.flatnonzero(seen)
     uniq, inv = np.unique(xyr[idx], axis=0, return_inverse=True)
-    full = np.empty((uniq.shape[0], pts.shape[0]))
+    full = np.empty((uniq.shape[0], g.shape[1]))
 
     def static(q):
         return np.column_stack([basis.static_deflection_at(p, q, 0.0) for p in pts])
+
+    if readings is not None:
+        static = readings.static
 
     with task("quasi-static correction", total=uniq.shape[0], unit="load points") as bar:
         for k in range(0, uniq.shape[0], RESIDUAL_BATCH):
@@ -312,29 +323,40 @@ def _check_memory(n_points, n_samples, loads, n_modes, batch_nodes, max_bytes):
 
 
 def sensor_outputs(basis, zeta, loads, sensors, duration, *, load_radius=0.0, quasi_static=True):
-    """name -> tailbeam.signals.sensor.SensorOutput for every sensor (SensorSpec) under ``loads``:
-    the chain of ``ModalReplay.sensor_outputs`` (true acceleration on the sensor's fine grid,
-    mounted resonance, anti-alias FIR, sampling, noise) over [0, duration] s, driven by
-    ``plate_response``. Sensors whose fine grids coincide share one plate response.
-    ``sensor_signals(outputs)`` gives what ``write_sensors_csv`` takes."""
+    """name -> tailbeam.signals.sensor.SensorOutput for every channel of every sensor
+    (``SensorSpec.channels``) under ``loads``: the chain of ``ModalReplay.sensor_outputs``
+    (true acceleration on the sensor's fine grid, mounted resonance, anti-alias FIR, sampling,
+    noise) over [0, duration] s, driven by ``plate_response``. Plain sensors (a point (x, y)
+    read along +z) whose fine grids coincide share one plate response, the other channels
+    another (``tailbeam.solvers.plate_loads.readings``). ``sensor_signals(outputs)`` gives
+    what ``write_sensors_csv`` takes."""
     f_top = float(np.max(basis.frequencies_hz))
-    positions = np.array([s.position for s in sensors], dtype=float).reshape(-1, 2)
+    plain = [s for s in sensors if s.plain]
+    other = [c for s in sensors if not s.plain for c in s.channels()]
+    positions = np.array([s.position for s in plain], dtype=float).reshape(-1, 2)
+    readings = Readings(basis, other) if other else None
     done = {}
 
-    def acceleration(times, index):
-        key = (len(times), float(times[1] - times[0]))
+    def acceleration(times, index, group):
+        key = (len(times), float(times[1] - times[0]), group)
         if key not in done:
             response = plate_response(
                 basis, zeta, loads, positions, times,
                 load_radius=load_radius, quasi_static=quasi_static,
+                readings=readings if group else None,
             )  # fmt: skip
             done[key] = response["a"]
         return done[key][index]
 
-    return {
-        s.name: measure(s, lambda t, i=i: acceleration(t, i), duration, max_frequency_hz=f_top)
-        for i, s in enumerate(sensors)
-    }
+    out = {}
+    for s in sensors:
+        for c in s.channels():
+            group = not s.plain
+            i = other.index(c) if group else plain.index(s)
+            out[c.name] = measure(
+                c, lambda t, i=i, g=group: acceleration(t, i, g), duration, max_frequency_hz=f_top
+            )
+    return out
 
 
 @dataclass(frozen=True, eq=False)
