@@ -21,14 +21,16 @@ mu and mu_r. What the two contact laws cannot share:
 Both runs' trajectories are sampled every 0.5 ms and reduced by the same code:
 
 * on the beam: centre over the plate and lowest point within 2 mm of it;
-* residence time: last minus first sample on the beam, for lumps that left before the end;
+* residence time: from the first sample on the beam to the first with the centre no longer
+  over the plate, for lumps that left before the end (bounces above the plate included);
 * landings per lump: entries onto the beam from above 2 mm (hops lower than 2 mm are not
   counted), over the lumps that touched it;
 * at rest: on the beam at the end with the centre slower than 1 cm/s (per lump that touched
   the beam).
 
 Each setting runs with several stream seeds; the table gives mean +- standard deviation over
-seeds. Writes ``table.md``, ``runs.csv`` and each LIGGGHTS run's directory into --out.
+seeds. Writes ``table.md`` (``--table NAME``), the runs in a CSV of the same name and each
+LIGGGHTS run's directory into --out.
 
     python benchmarks/compare_liggghts.py --out DIR [--quick] [--seeds 1 2 3]
 
@@ -60,10 +62,13 @@ HALF = 0.3  # m: half side of the plate
 DT = 2e-6  # s: LIGGGHTS timestep (~10 % of the Rayleigh time of a 10 mm sandstone lump)
 TYPES = {"coal": 1, "sandstone": 2, "carbon_steel": 3}
 
-SETTINGS = {
-    "frictionless": (0.0, 0.0),
-    "mu=0.5 mu_r=0.1": (0.5, 0.1),
-    "mu=0.7 mu_r=0.7": (0.7, 0.7),
+HIGH, LOW = (0.3, 0.8), (0.02, 0.1)  # m: release gaps, the reference scene's and a low drop
+SETTINGS = {  # name: mu, mu_r, release gaps
+    "frictionless": (0.0, 0.0, HIGH),
+    "mu=0.5 mu_r=0.1": (0.5, 0.1, HIGH),
+    "mu=0.7 mu_r=0.7": (0.7, 0.7, HIGH),
+    "low drop, mu=0.5 mu_r=0.1": (0.5, 0.1, LOW),
+    "low drop, mu=0.7 mu_r=0.7": (0.7, 0.7, LOW),
 }
 
 SCENE = """
@@ -84,7 +89,7 @@ stop = {stop}
 gangue_fraction = 0.3
 radius = [0.01, 0.04]
 area = [[-0.3, 0.1], [-0.2, 0.2]]
-height = [0.3, 0.8]
+height = [{h0}, {h1}]
 seed = {seed}
 """
 
@@ -97,9 +102,11 @@ rolling = {mu_r}
 """
 
 
-def scene(mu, mu_r, seed, stop, duration):
+def scene(mu, mu_r, seed, stop, duration, height=HIGH):
     friction = FRICTION.format(mu=mu, mu_r=mu_r) if mu > 0 or mu_r > 0 else ""
-    text = SCENE.format(duration=duration, stop=stop, seed=seed, friction=friction)
+    text = SCENE.format(
+        duration=duration, stop=stop, seed=seed, friction=friction, h0=height[0], h1=height[1]
+    )
     return loads_scene(text)
 
 
@@ -257,8 +264,9 @@ def flow_stats(pos, vel, radius, labels=None) -> dict:
         k = np.flatnonzero(on[:, i])
         entries = int(on[0, i]) + int(np.sum(on[1:, i] & ~on[:-1, i]))
         landings.append(entries)
-        if k[-1] < last - 20:  # left 10 ms or more before the end
-            residence.append((k[-1] - k[0]) * SAMPLE)
+        gone = np.flatnonzero(~over[k[0] :, i])  # centre no longer over the plate
+        if gone.size:
+            residence.append(gone[0] * SAMPLE)
     speed = np.linalg.norm(vel[last], axis=1)
     rest = on[last] & (speed < REST_SPEED)
     return {
@@ -317,6 +325,7 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="~70 lumps over 0.35 s, 1 s simulated")
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     ap.add_argument("--settings", nargs="+", default=list(SETTINGS), choices=list(SETTINGS))
+    ap.add_argument("--table", default="table.md", help="name of the table written into --out")
     ap.add_argument("--rolling-models", nargs="+", default=["cdt"], choices=["cdt", "epsd2"])
     args = ap.parse_args(argv)
     if shutil.which("liggghts") is None:
@@ -327,9 +336,9 @@ def main(argv=None):
     stop, duration = (0.35, 1.0) if args.quick else (0.5, 1.5)
     rows = []
     for setting in args.settings:
-        mu, mu_r = SETTINGS[setting]
+        mu, mu_r, height = SETTINGS[setting]
         for seed in args.seeds:
-            sc = scene(mu, mu_r, seed, stop, duration)
+            sc = scene(mu, mu_r, seed, stop, duration, height)
             result, wall = run_tailbeam(sc)
             pos, vel, radius = tailbeam_arrays(result)
             rows.append({"setting": setting, "code": "tailbeam", "seed": seed,
@@ -337,18 +346,19 @@ def main(argv=None):
             print(f"{setting} seed {seed} tailbeam: {rows[-1]}", file=sys.stderr)
             order = np.argsort(result.particles_table()["t_release"], kind="stable")
             for model in args.rolling_models:
-                tag = f"{setting.replace(' ', '_').replace('=', '')}_{model}_seed{seed}"
+                tag = setting.replace(" ", "_").replace("=", "").replace(",", "")
+                tag = f"{tag}_{model}_seed{seed}"
                 lp, lv, wall = run_liggghts(args.out / tag, result, mu, mu_r, model, duration)
                 code = f"LIGGGHTS ({model})"
                 rows.append({"setting": setting, "code": code, "seed": seed,
                              **flow_stats(lp, lv, radius[order]), "wall_s": wall})  # fmt: skip
                 print(f"{setting} seed {seed} {code}: {rows[-1]}", file=sys.stderr)
-    with (args.out / "runs.csv").open("w", newline="") as fh:
+    with (args.out / args.table.replace(".md", ".csv")).open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    write_table(args.out / "table.md", rows, args.seeds, sys.argv[1:] if argv is None else argv)
-    print((args.out / "table.md").read_text())
+    write_table(args.out / args.table, rows, args.seeds, sys.argv[1:] if argv is None else argv)
+    print((args.out / args.table).read_text())
 
 
 if __name__ == "__main__":

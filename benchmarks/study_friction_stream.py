@@ -233,12 +233,12 @@ def summarise(name, result, lumps, wall, duration) -> dict:
     return row
 
 
-def spectrum(t, a):
-    """(f Hz, one-sided PSD (m/s^2)^2/Hz) by Welch's method, 4096-sample segments."""
+def spectrum(t, a, segment=4096):
+    """(f Hz, one-sided PSD (m/s^2)^2/Hz) by Welch's method, ``segment``-sample segments."""
     from scipy.signal import welch
 
     fs = 1.0 / float(np.median(np.diff(t)))
-    return welch(a, fs=fs, nperseg=min(4096, a.size))
+    return welch(a, fs=fs, nperseg=min(segment, a.size))
 
 
 def write_csv(path, rows):
@@ -285,6 +285,31 @@ def write_table(path, rows, args):
 COLOURS = {"coal": "0.15", "gangue": "tab:orange"}
 
 
+def case_data(result, lumps) -> dict:
+    """What the figures need of a run, as arrays (saved as ``case_CASE.npz``)."""
+    imp = result.impacts_table()
+    index = {r["name"]: i for i, r in enumerate(lumps)}
+    plate = np.flatnonzero(imp["partner"] == "plate")
+    data = {
+        "times": np.asarray(result.frames.times),
+        "position": result.frames.position,
+        "speed": np.linalg.norm(result.frames.velocity, axis=2),
+        "radius": np.array([r["radius"] for r in lumps]),
+        "label": np.array([r["label"] for r in lumps]),
+        "t_touch": np.array([r["t_touch"] for r in lumps]),
+        "impact_ball": np.array([index[b] for b in imp["ball"][plate]], dtype=int),
+        "impact_t": np.asarray(imp["t_start"][plate], float),
+        "impact_x": np.asarray(imp["x"][plate], float),
+    }
+    for sensor, (t, a) in result.sensor_signals.items():
+        data[f"signal_{sensor}_t"], data[f"signal_{sensor}_a"] = np.asarray(t), np.asarray(a)
+    return data
+
+
+def npz_name(case: str) -> str:
+    return "case_" + case.replace(" ", "_").replace(",", "") + ".npz"
+
+
 def plot_lumps(path, runs, duration):
     """Plate-frame x of every lump from its first plate contact on against t, one panel per
     case: thin in flight, thick while it touches the plate, a dot at each plate impact, a
@@ -298,27 +323,22 @@ def plot_lumps(path, runs, duration):
     nrow = math.ceil(len(runs) / ncol)
     fig, axes = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 3.4 * nrow + 0.6), sharey=True,
                              squeeze=False)  # fmt: skip
-    for ax, (name, result, lumps) in zip(axes.flat, runs, strict=False):
-        fr = result.frames
-        imp = result.impacts_table()
-        plate = imp["partner"] == "plate"
-        radius = np.array([r["radius"] for r in lumps])
-        on = fr.position[:, :, 2] - radius[None, :] < ON_BEAM_GAP
-        speed = np.linalg.norm(fr.velocity, axis=2)
-        for i, r in enumerate(lumps):
-            if not np.isfinite(r["t_touch"]):
+    for ax, (name, d) in zip(axes.flat, runs, strict=False):
+        t, pos = d["times"], d["position"]
+        on = pos[:, :, 2] - d["radius"][None, :] < ON_BEAM_GAP
+        for i, label in enumerate(d["label"]):
+            if not np.isfinite(d["t_touch"][i]):
                 continue
-            colour = COLOURS.get(r["label"], "tab:orange")
-            after = fr.times >= r["t_touch"] - 0.5 * FRAME_STEP
-            x = np.where(after, fr.position[:, i, 0], np.nan)
-            ax.plot(fr.times, x, color=colour, lw=0.4, alpha=0.6)
-            ax.plot(fr.times, np.where(on[:, i], x, np.nan), color=colour, lw=1.8)
-            mine = plate & (imp["ball"] == r["name"])
-            ax.plot(imp["t_start"][mine], imp["x"][mine], ".", ms=3.0, color=colour)
-            rest = on[:, i] & (speed[:, i] < REST_SPEED)
+            colour = COLOURS.get(str(label), "tab:orange")
+            x = np.where(t >= d["t_touch"][i] - 0.5 * FRAME_STEP, pos[:, i, 0], np.nan)
+            ax.plot(t, x, color=colour, lw=0.4, alpha=0.6)
+            ax.plot(t, np.where(on[:, i], x, np.nan), color=colour, lw=1.8)
+            mine = d["impact_ball"] == i
+            ax.plot(d["impact_t"][mine], d["impact_x"][mine], ".", ms=3.0, color=colour)
+            rest = on[:, i] & (d["speed"][:, i] < REST_SPEED)
             if rest.any():
-                ax.plot(fr.times[rest], fr.position[rest, i, 0], "o", ms=3.0, mfc="none",
-                        color="tab:blue", mew=0.6)  # fmt: skip
+                ax.plot(t[rest], pos[rest, i, 0], "o", ms=3.0, mfc="none", color="tab:blue",
+                        mew=0.6)  # fmt: skip
         ax.set_title(name, fontsize=10)
         ax.set_xlabel("t (s)")
         ax.set_xlim(0.0, duration)
@@ -347,32 +367,35 @@ def plot_lumps(path, runs, duration):
 
 
 def plot_stats(path, rows):
-    """The statistics against the case."""
+    """The statistics against the case (low releases in a second colour)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = [r["case"].replace(" ", "\n") for r in rows]
+    names = [r["case"].replace("low drop, ", "low drop\n").replace(" mu_r", "\nmu_r") for r in rows]
+    colour = ["tab:green" if r["case"].startswith("low") else "tab:blue" for r in rows]
     panels = [
-        ("residence_mean_s", "mean residence on the beam (s)"),
-        ("plate_impacts_per_lump", "plate impacts per lump"),
-        ("fraction_at_rest", "lumps at rest at the end\n/ lumps that touched the beam"),
+        ("residence_mean_s", "mean residence on the beam (s)\nfirst touch to leaving"),
+        ("plate_impacts_per_lump", "plate impacts per lump\nthat touched the beam"),
+        ("on_beam_end", "lumps on the beam at the end\n(circles: of them at rest)"),
         ("S1_rms", "S1 in-band RMS (m/s²)"),
-        ("auc_peak_force", "coal/gangue AUC"),
+        ("auc_peak_force", "coal/gangue AUC (0.5: none)\nbars: first peak force"),
     ]
     panels = [p for p in panels if p[0] in rows[0]]
-    fig, axes = plt.subplots(1, len(panels), figsize=(3.2 * len(panels), 3.6))
+    fig, axes = plt.subplots(1, len(panels), figsize=(3.3 * len(panels), 4.0))
     x = np.arange(len(rows))
     for ax, (key, label) in zip(axes, panels, strict=True):
-        ax.bar(x, [r[key] for r in rows], color="tab:blue", width=0.6, label="first peak force")
+        ax.bar(x, [float(r[key]) for r in rows], color=colour, width=0.6)
+        if key == "on_beam_end":
+            ax.plot(x, [float(r["at_rest_end"]) for r in rows], "o", mfc="none", color="k")
         if key == "auc_peak_force" and "auc_S1_window_rms" in rows[0]:
-            ax.plot(x, [r["auc_S1_window_rms"] for r in rows], "o", color="tab:red",
-                    label="S1 20 ms RMS")  # fmt: skip
+            ax.plot(x, [float(r["auc_S1_window_rms"]) for r in rows], "o", color="tab:red",
+                    label="S1 RMS, 20 ms after it")  # fmt: skip
             ax.axhline(0.5, color="0.4", lw=0.8, ls="--")
             ax.set_ylim(0.0, 1.0)
-            ax.legend(fontsize=7, loc="lower left")
-        ax.set_xticks(x, names, fontsize=7)
+            ax.legend(fontsize=7, loc="lower left", framealpha=0.9)
+        ax.set_xticks(x, names, fontsize=7, rotation=60, ha="right", rotation_mode="anchor")
         ax.set_title(label, fontsize=9)
         ax.grid(alpha=0.3, axis="y")
     fig.tight_layout()
@@ -381,25 +404,39 @@ def plot_stats(path, rows):
 
 
 def plot_spectrum(path, runs):
-    """Welch spectrum of S1 per case."""
+    """Welch spectrum of S1 per case (releases from the reference heights), and each friction
+    case's spectrum over the frictionless one of the same release heights, in dB."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.2))
-    for name, result, _ in runs:
-        signals = result.sensor_signals
-        if "S1" not in signals:
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8.0, 6.4), sharex=True,
+                                      gridspec_kw={"height_ratios": [3, 2]})  # fmt: skip
+    base = {}
+    for name, d in runs:
+        if "signal_S1_a" not in d:
             continue
-        f, p = spectrum(*signals["S1"])
-        ax.semilogy(f / 1e3, p, lw=0.9, label=name)
-    ax.set_xlabel("frequency (kHz)")
-    ax.set_ylabel("S1 PSD ((m/s²)²/Hz)")
-    ax.set_xlim(0.0, 10.0)
-    ax.set_title("S1 acceleration spectrum (Welch, one-way modal replay, 10 kHz band)", fontsize=10)
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=8)
+        f, p = spectrum(d["signal_S1_t"], d["signal_S1_a"], 1024)
+        low = name.startswith("low")
+        if "frictionless" in name:
+            base[low] = p
+        if not low:
+            top.semilogy(f / 1e3, p, lw=0.9, label=name)
+        if low in base and "frictionless" not in name:
+            bottom.plot(f / 1e3, 10 * np.log10(p / base[low]), lw=0.9, ls="--" if low else "-",
+                        label=name)  # fmt: skip
+    top.set_ylabel("S1 PSD ((m/s²)²/Hz)")
+    top.set_title("S1 acceleration, one-way modal replay (10 kHz band), Welch, 50 Hz bins",
+                  fontsize=10)  # fmt: skip
+    top.grid(alpha=0.3, which="both")
+    top.legend(fontsize=8)
+    bottom.axhline(0.0, color="0.3", lw=0.8)
+    bottom.set_ylabel("over frictionless (dB)")
+    bottom.set_xlabel("frequency (kHz)")
+    bottom.set_xlim(0.0, 10.0)
+    bottom.grid(alpha=0.3)
+    bottom.legend(fontsize=8, ncol=2)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -411,26 +448,35 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="~100 lumps over 0.5 s, 1 s simulated")
     ap.add_argument("--no-sensors", action="store_true", help="rigid plate only, no replay")
     ap.add_argument("--cases", nargs="*", help="names of the cases to run (default: all)")
+    ap.add_argument("--replot", action="store_true", help="figures from the saved cases only")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     stop, duration = (0.5, 1.0) if args.quick else (2.0, 3.0)
     cases = [c for c in CASES if not args.cases or c[0] in args.cases]
-    rows, runs = [], []
-    for name, mu, mu_r, height in cases:
-        print(f"case {name}", file=sys.stderr)
-        result, wall = run_case(mu, mu_r, stop=stop, duration=duration, height=height,
-                                sensors=not args.no_sensors)  # fmt: skip
-        lumps = lump_table(result)
-        write_csv(args.out / f"lumps_{name.replace(' ', '_')}.csv", lumps)
-        row = summarise(name, result, lumps, wall, duration)
-        rows.append(row)
-        runs.append((name, result, lumps))
-        print("  " + ", ".join(f"{k}={fmt(v)}" for k, v in row.items()), file=sys.stderr)
-    write_csv(args.out / "cases.csv", rows)
-    write_table(args.out / "table.md", rows, args)
+    if args.replot:
+        with (args.out / "cases.csv").open() as fh:
+            rows = list(csv.DictReader(fh))
+        runs = [(r["case"], dict(np.load(args.out / npz_name(r["case"])))) for r in rows]
+        duration = max(float(d["times"][-1]) for _, d in runs)
+    else:
+        rows, runs = [], []
+        for name, mu, mu_r, height in cases:
+            print(f"case {name}", file=sys.stderr)
+            result, wall = run_case(mu, mu_r, stop=stop, duration=duration, height=height,
+                                    sensors=not args.no_sensors)  # fmt: skip
+            lumps = lump_table(result)
+            write_csv(args.out / f"lumps_{name.replace(' ', '_').replace(',', '')}.csv", lumps)
+            row = summarise(name, result, lumps, wall, duration)
+            rows.append(row)
+            data = case_data(result, lumps)
+            np.savez_compressed(args.out / npz_name(name), **data)
+            runs.append((name, data))
+            print("  " + ", ".join(f"{k}={fmt(v)}" for k, v in row.items()), file=sys.stderr)
+        write_csv(args.out / "cases.csv", rows)
+        write_table(args.out / "table.md", rows, args)
     plot_lumps(args.out / "friction-stream-lumps.png", runs, duration)
     plot_stats(args.out / "friction-stream-stats.png", rows)
-    if not args.no_sensors:
+    if any("signal_S1_a" in d for _, d in runs):
         plot_spectrum(args.out / "friction-stream-spectrum.png", runs)
     print((args.out / "table.md").read_text())
 
