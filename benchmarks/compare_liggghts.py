@@ -61,6 +61,7 @@ REST_SPEED = 0.01  # m/s
 HALF = 0.3  # m: half side of the plate
 DT = 2e-6  # s: LIGGGHTS timestep (~10 % of the Rayleigh time of a 10 mm sandstone lump)
 TYPES = {"coal": 1, "sandstone": 2, "carbon_steel": 3}
+FIRST_LUMP_ID = 2  # LIGGGHTS atom 1 is stream.in's anchor grain
 
 HIGH, LOW = (0.3, 0.8), (0.02, 0.1)  # m: release gaps, the reference scene's and a low drop
 SETTINGS = {  # name: mu, mu_r, release gaps
@@ -179,7 +180,7 @@ def write_releases(path, result):
     p = result.particles_table()
     order = np.argsort(p["t_release"], kind="stable")
     lines = []
-    for atom_id, i in enumerate(order, start=1):
+    for atom_id, i in enumerate(order, start=FIRST_LUMP_ID):
         step = int(math.ceil(p["t_release"][i] / DT))
         rho = get_material(p["material"][i]).density
         lines += [
@@ -243,7 +244,8 @@ def read_dump(path, n, every, duration):
             rows = lines[k + 9 : k + 9 + count]
             if rows and f < times.size:
                 a = np.array([r.split() for r in rows], dtype=float)
-                ids = a[:, 0].astype(int) - 1
+                a = a[a[:, 0] >= FIRST_LUMP_ID]
+                ids = a[:, 0].astype(int) - FIRST_LUMP_ID
                 pos[f, ids] = a[:, 3:6]
                 vel[f, ids] = a[:, 6:9]
             k += 9 + count
