@@ -414,6 +414,7 @@ def plot_spectrum(path, runs):
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(8.0, 6.4), sharex=True,
                                       gridspec_kw={"height_ratios": [3, 2]})  # fmt: skip
     base = {}
+    colour = {name: f"C{k}" for k, (name, _) in enumerate(runs)}
     for name, d in runs:
         if "signal_S1_a" not in d:
             continue
@@ -422,10 +423,10 @@ def plot_spectrum(path, runs):
         if "frictionless" in name:
             base[low] = p
         if not low:
-            top.semilogy(f / 1e3, p, lw=0.9, label=name)
+            top.semilogy(f / 1e3, p, lw=0.9, label=name, color=colour[name])
         if low in base and "frictionless" not in name:
             bottom.plot(f / 1e3, 10 * np.log10(p / base[low]), lw=0.9, ls="--" if low else "-",
-                        label=name)  # fmt: skip
+                        label=name, color=colour[name])  # fmt: skip
     top.set_ylabel("S1 PSD ((m/s²)²/Hz)")
     top.set_title("S1 acceleration, one-way modal replay (10 kHz band), Welch, 50 Hz bins",
                   fontsize=10)  # fmt: skip
