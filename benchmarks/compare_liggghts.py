@@ -62,6 +62,9 @@ HALF = 0.3  # m: half side of the plate
 DT = 2e-6  # s: LIGGGHTS timestep (~10 % of the Rayleigh time of a 10 mm sandstone lump)
 TYPES = {"coal": 1, "sandstone": 2, "carbon_steel": 3}
 FIRST_LUMP_ID = 2  # LIGGGHTS atom 1 is stream.in's anchor grain
+AREA = ((-0.3, 0.1), (-0.2, 0.2))  # m: the stream's release area
+R_MAX = 0.04  # m: the largest lump radius
+CANDIDATES = 20  # release places tried per lump in LIGGGHTS
 
 HIGH, LOW = (0.3, 0.8), (0.02, 0.1)  # m: release gaps, the reference scene's and a low drop
 SETTINGS = {  # name: mu, mu_r, release gaps
@@ -89,7 +92,7 @@ start = 0.0
 stop = {stop}
 gangue_fraction = 0.3
 radius = [0.01, 0.04]
-area = [[-0.3, 0.1], [-0.2, 0.2]]
+area = [[{x0}, {x1}], [{y0}, {y1}]]
 height = [{h0}, {h1}]
 seed = {seed}
 """
@@ -106,8 +109,9 @@ rolling = {mu_r}
 def scene(mu, mu_r, seed, stop, duration, height=HIGH):
     friction = FRICTION.format(mu=mu, mu_r=mu_r) if mu > 0 or mu_r > 0 else ""
     text = SCENE.format(
-        duration=duration, stop=stop, seed=seed, friction=friction, h0=height[0], h1=height[1]
-    )
+        duration=duration, stop=stop, seed=seed, friction=friction, h0=height[0], h1=height[1],
+        x0=AREA[0][0], x1=AREA[0][1], y0=AREA[1][0], y1=AREA[1][1],
+    )  # fmt: skip
     return loads_scene(text)
 
 
@@ -175,21 +179,50 @@ def write_materials(path, restitution, mu, mu_r, rolling_model):
     Path(path).write_text("\n".join(lines) + "\n")
 
 
-def write_releases(path, result):
-    """One block per lump in release order: run to its release step, create, size it."""
+def candidates(p, i, height, n=CANDIDATES):
+    """Release places of lump i (plate frame, m): the one tailbeam used, then ``n - 1`` drawn
+    over the stream's release volume (area, gap ``height``) from the lump's number."""
+    rng = np.random.default_rng(1000 + int(i))
+    r = float(p["radius"][i])
+    (x0, x1), (y0, y1) = AREA
+    drawn = np.column_stack(
+        [
+            rng.uniform(x0, x1, n - 1),
+            rng.uniform(y0, y1, n - 1),
+            rng.uniform(height[0], height[1], n - 1) + r,
+        ]
+    )
+    return np.vstack([[p["x0"][i], p["y0"][i], p["z0"][i]], drawn])
+
+
+def write_releases(path, result, height):
+    """One block per lump in release order: run to its release step, then create it at the
+    first of its candidate places with no lump centre within its radius + R_MAX (tailbeam's
+    rule: another free place of the release volume; the last candidate if none is free),
+    and size it. Returns the lumps' order."""
     p = result.particles_table()
     order = np.argsort(p["t_release"], kind="stable")
     lines = []
     for atom_id, i in enumerate(order, start=FIRST_LUMP_ID):
         step = int(math.ceil(p["t_release"][i] / DT))
         rho = get_material(p["material"][i]).density
-        lines += [
-            f"run {step} upto",
-            f"create_atoms {TYPES[p['material'][i]]} single {p['x0'][i]:.9g} {p['y0'][i]:.9g} "
-            f"{p['z0'][i]:.9g} units box",
-            f"set atom {atom_id} diameter {2.0 * p['radius'][i]:.9g}",
-            f"set atom {atom_id} density {rho:.9g}",
-        ]
+        kind, r = TYPES[p["material"][i]], float(p["radius"][i])
+        lines += [f"run {step} upto", "variable placed string 0"]
+        places = candidates(p, i, height)
+        for j, (x, y, z) in enumerate(places):
+            create = (
+                f'"create_atoms {kind} single {x:.9g} {y:.9g} {z:.9g} units box" '
+                f'"set atom {atom_id} diameter {2.0 * r:.9g}" '
+                f'"set atom {atom_id} density {rho:.9g}" "variable placed string 1"'
+            )
+            if j == len(places) - 1:
+                lines.append(f'if "${{placed}} == 0" then {create}')
+                continue
+            lines += [
+                f"region probe sphere {x:.9g} {y:.9g} {z:.9g} {r + R_MAX + 2e-3:.9g} units box",
+                f'if "${{placed}} == 0 && $(count(all,probe)) == 0" then {create}',
+                "region probe delete",
+            ]
     Path(path).write_text("\n".join(lines) + "\n")
     return order
 
@@ -207,12 +240,12 @@ def write_plate(path):
     Path(path).write_text("\n".join(lines) + "\n")
 
 
-def run_liggghts(workdir, result, mu, mu_r, rolling_model, duration):
+def run_liggghts(workdir, result, mu, mu_r, rolling_model, duration, height):
     """Write the inputs, run LIGGGHTS; (position, velocity, radius arrays, wall s)."""
     workdir.mkdir(parents=True, exist_ok=True)
     shutil.copy(HERE / "stream.in", workdir / "stream.in")
     write_materials(workdir / "materials.in", restitutions(result), mu, mu_r, rolling_model)
-    order = write_releases(workdir / "releases.in", result)
+    order = write_releases(workdir / "releases.in", result, height)
     write_plate(workdir / "plate.stl")
     every = int(round(SAMPLE / DT))
     cmd = [
@@ -269,6 +302,7 @@ def flow_stats(pos, vel, radius, labels=None) -> dict:
         gone = np.flatnonzero(~over[k[0] :, i])  # centre no longer over the plate
         if gone.size:
             residence.append(gone[0] * SAMPLE)
+    fastest = float(np.nanmax(np.linalg.norm(vel, axis=2)))
     speed = np.linalg.norm(vel[last], axis=1)
     rest = on[last] & (speed < REST_SPEED)
     return {
@@ -279,6 +313,7 @@ def flow_stats(pos, vel, radius, labels=None) -> dict:
         "on_beam_end": int(on[last].sum()),
         "at_rest_end": int(rest.sum()),
         "fraction_at_rest": float(rest.sum() / max(1, touched.sum())),
+        "max_speed": fastest,
     }
 
 
@@ -302,6 +337,8 @@ def write_table(path, rows, seeds, argv):
         ("landings", "landings per lump"),
         ("fraction_at_rest", "at rest at the end / touched"),
         ("touched", "lumps that touched the beam"),
+        ("on_beam_end", "on the beam at the end"),
+        ("max_speed", "fastest lump (m/s)"),
     ]
     lines = [
         "    python benchmarks/compare_liggghts.py " + " ".join(argv),
@@ -350,7 +387,9 @@ def main(argv=None):
             for model in args.rolling_models:
                 tag = setting.replace(" ", "_").replace("=", "").replace(",", "")
                 tag = f"{tag}_{model}_seed{seed}"
-                lp, lv, wall = run_liggghts(args.out / tag, result, mu, mu_r, model, duration)
+                lp, lv, wall = run_liggghts(
+                    args.out / tag, result, mu, mu_r, model, duration, height
+                )
                 code = f"LIGGGHTS ({model})"
                 rows.append({"setting": setting, "code": code, "seed": seed,
                              **flow_stats(lp, lv, radius[order]), "wall_s": wall})  # fmt: skip
