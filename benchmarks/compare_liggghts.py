@@ -65,6 +65,7 @@ FIRST_LUMP_ID = 2  # LIGGGHTS atom 1 is stream.in's anchor grain
 AREA = ((-0.3, 0.1), (-0.2, 0.2))  # m: the stream's release area
 R_MAX = 0.04  # m: the largest lump radius
 CANDIDATES = 20  # release places tried per lump in LIGGGHTS
+RETRIES, RETRY_WAIT = 10, 1e-3  # s: when every candidate is taken, wait and try again
 
 HIGH, LOW = (0.3, 0.8), (0.02, 0.1)  # m: release gaps, the reference scene's and a low drop
 SETTINGS = {  # name: mu, mu_r, release gaps
@@ -198,10 +199,12 @@ def candidates(p, i, height, n=CANDIDATES):
 def write_releases(path, result, height):
     """One block per lump in release order: run to its release step, then create it at the
     first of its candidate places with no lump centre within its radius + R_MAX (tailbeam's
-    rule: another free place of the release volume; the last candidate if none is free),
-    and size it. Returns the lumps' order."""
+    rule: another free place of the release volume); when none is free, wait RETRY_WAIT and
+    try again, up to RETRIES times, then take the first candidate. Size it. Returns the lumps'
+    order."""
     p = result.particles_table()
     order = np.argsort(p["t_release"], kind="stable")
+    wait = int(round(RETRY_WAIT / DT))
     lines = []
     for atom_id, i in enumerate(order, start=FIRST_LUMP_ID):
         step = int(math.ceil(p["t_release"][i] / DT))
@@ -209,20 +212,24 @@ def write_releases(path, result, height):
         kind, r = TYPES[p["material"][i]], float(p["radius"][i])
         lines += [f"run {step} upto", "variable placed string 0"]
         places = candidates(p, i, height)
-        for j, (x, y, z) in enumerate(places):
-            create = (
+
+        def create(x, y, z, kind=kind, r=r, rho=rho, atom_id=atom_id):
+            return (
                 f'"create_atoms {kind} single {x:.9g} {y:.9g} {z:.9g} units box" '
                 f'"set atom {atom_id} diameter {2.0 * r:.9g}" '
                 f'"set atom {atom_id} density {rho:.9g}" "variable placed string 1"'
             )
-            if j == len(places) - 1:
-                lines.append(f'if "${{placed}} == 0" then {create}')
-                continue
-            lines += [
-                f"region probe sphere {x:.9g} {y:.9g} {z:.9g} {r + R_MAX + 2e-3:.9g} units box",
-                f'if "${{placed}} == 0 && $(count(all,probe)) == 0" then {create}',
-                "region probe delete",
-            ]
+
+        for attempt in range(RETRIES):
+            if attempt:
+                lines.append(f'if "${{placed}} == 0" then "run {wait}"')
+            for x, y, z in places:
+                lines += [
+                    f"region probe sphere {x:.9g} {y:.9g} {z:.9g} {r + R_MAX + 2e-3:.9g} units box",
+                    f'if "${{placed}} == 0 && $(count(all,probe)) == 0" then {create(x, y, z)}',
+                    "region probe delete",
+                ]
+        lines.append(f'if "${{placed}} == 0" then {create(*places[0])}')
     Path(path).write_text("\n".join(lines) + "\n")
     return order
 
