@@ -210,7 +210,11 @@ def write_releases(path, result, height):
         step = int(math.ceil(p["t_release"][i] / DT))
         rho = get_material(p["material"][i]).density
         kind, r = TYPES[p["material"][i]], float(p["radius"][i])
-        lines += [f"run {step} upto", "variable placed string 0"]
+        lines += [
+            f"variable togo equal ({step}-step)*({step}>step)",
+            "run ${togo}",
+            "variable placed string 0",
+        ]
         places = candidates(p, i, height)
 
         def create(x, y, z, kind=kind, r=r, rho=rho, atom_id=atom_id):
