@@ -65,7 +65,8 @@ FIRST_LUMP_ID = 2  # LIGGGHTS atom 1 is stream.in's anchor grain
 AREA = ((-0.3, 0.1), (-0.2, 0.2))  # m: the stream's release area
 R_MAX = 0.04  # m: the largest lump radius
 CANDIDATES = 20  # release places tried per lump in LIGGGHTS
-RETRIES, RETRY_WAIT = 10, 1e-3  # s: when every candidate is taken, wait and try again
+RETRIES, RETRY_WAIT = 300, 1e-3  # s: when every candidate is taken, wait and try again
+PARK_X, PARK_Y, PARK_Z = (0.9, 1.0, 1.1, 1.2, 1.3, 1.4), np.arange(-0.6, 0.61, 0.1), 1.2  # m
 
 HIGH, LOW = (0.3, 0.8), (0.02, 0.1)  # m: release gaps, the reference scene's and a low drop
 SETTINGS = {  # name: mu, mu_r, release gaps
@@ -200,22 +201,17 @@ def write_releases(path, result, height):
     """One block per lump in release order: run to its release step, then create it at the
     first of its candidate places with no lump centre within its radius + R_MAX (tailbeam's
     rule: another free place of the release volume); when none is free, wait RETRY_WAIT and
-    try again, up to RETRIES times, then take the first candidate. Size it. Returns the lumps'
-    order."""
+    try again, up to RETRIES times; a lump that never finds a place is parked, held still,
+    outside the beam. Returns the lumps' order."""
     p = result.particles_table()
     order = np.argsort(p["t_release"], kind="stable")
     wait = int(round(RETRY_WAIT / DT))
     lines = []
-    for atom_id, i in enumerate(order, start=FIRST_LUMP_ID):
+    for k, i in enumerate(order):
+        atom_id = FIRST_LUMP_ID + k
         step = int(math.ceil(p["t_release"][i] / DT))
         rho = get_material(p["material"][i]).density
         kind, r = TYPES[p["material"][i]], float(p["radius"][i])
-        lines += [
-            f"variable togo equal ({step}-step)*({step}>step)",
-            "run ${togo}",
-            "variable placed string 0",
-        ]
-        places = candidates(p, i, height)
 
         def create(x, y, z, kind=kind, r=r, rho=rho, atom_id=atom_id):
             return (
@@ -224,16 +220,29 @@ def write_releases(path, result, height):
                 f'"set atom {atom_id} density {rho:.9g}" "variable placed string 1"'
             )
 
-        for attempt in range(RETRIES):
-            if attempt:
-                lines.append(f'if "${{placed}} == 0" then "run {wait}"')
-            for x, y, z in places:
-                lines += [
-                    f"region probe sphere {x:.9g} {y:.9g} {z:.9g} {r + R_MAX + 2e-3:.9g} units box",
-                    f'if "${{placed}} == 0 && $(count(all,probe)) == 0" then {create(x, y, z)}',
-                    "region probe delete",
-                ]
-        lines.append(f'if "${{placed}} == 0" then {create(*places[0])}')
+        lines += [
+            f"variable togo equal ({step}-step)*({step}>step)",
+            "run ${togo}",
+            "variable placed string 0",
+            f"variable attempt loop {RETRIES}",
+            f"label try_{atom_id}",
+        ]
+        for x, y, z in candidates(p, i, height):
+            lines += [
+                f"region probe sphere {x:.9g} {y:.9g} {z:.9g} {r + R_MAX + 2e-3:.9g} units box",
+                f'if "${{placed}} == 0 && $(count(all,probe)) == 0" then {create(x, y, z)}',
+                "region probe delete",
+            ]
+        park = (PARK_X[k % len(PARK_X)], PARK_Y[(k // len(PARK_X)) % len(PARK_Y)], PARK_Z)
+        lines += [
+            f'if "${{placed}} == 1" then "jump SELF placed_{atom_id}"',
+            f"run {wait}",
+            "next attempt",
+            f"jump SELF try_{atom_id}",
+            f"label placed_{atom_id}",
+            "variable attempt delete",
+            f'if "${{placed}} == 0" then {create(*park)} "group held id {atom_id}"',
+        ]
     Path(path).write_text("\n".join(lines) + "\n")
     return order
 
@@ -313,7 +322,9 @@ def flow_stats(pos, vel, radius, labels=None) -> dict:
         gone = np.flatnonzero(~over[k[0] :, i])  # centre no longer over the plate
         if gone.size:
             residence.append(gone[0] * SAMPLE)
-    fastest = float(np.nanmax(np.linalg.norm(vel, axis=2)))
+    parked = (pos[:, :, 0] > PARK_X[0] - 0.05) & (pos[:, :, 2] > PARK_Z - 0.05)
+    moving = ~parked.any(axis=0)
+    fastest = float(np.nanmax(np.linalg.norm(vel[:, moving], axis=2)))
     speed = np.linalg.norm(vel[last], axis=1)
     rest = on[last] & (speed < REST_SPEED)
     return {
@@ -325,6 +336,7 @@ def flow_stats(pos, vel, radius, labels=None) -> dict:
         "at_rest_end": int(rest.sum()),
         "fraction_at_rest": float(rest.sum() / max(1, touched.sum())),
         "max_speed": fastest,
+        "parked": int((~moving).sum()),
     }
 
 
@@ -350,6 +362,7 @@ def write_table(path, rows, seeds, argv):
         ("touched", "lumps that touched the beam"),
         ("on_beam_end", "on the beam at the end"),
         ("max_speed", "fastest lump (m/s)"),
+        ("parked", "lumps that found no place"),
     ]
     lines = [
         "    python benchmarks/compare_liggghts.py " + " ".join(argv),
