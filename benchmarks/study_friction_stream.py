@@ -377,7 +377,7 @@ def plot_stats(path, rows):
     colour = ["tab:green" if r["case"].startswith("low") else "tab:blue" for r in rows]
     panels = [
         ("residence_mean_s", "mean residence on the beam (s)\nfirst touch to leaving"),
-        ("plate_impacts_per_lump", "plate impacts per lump\nthat touched the beam"),
+        ("plate_impacts_per_lump", "plate contact records per lump\nthat touched the beam"),
         ("on_beam_end", "lumps on the beam at the end\n(circles: of them at rest)"),
         ("S1_rms", "S1 in-band RMS (m/s²)"),
         ("auc_peak_force", "coal/gangue AUC (0.5: none)\nbars: first peak force"),
