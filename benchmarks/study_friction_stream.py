@@ -261,7 +261,7 @@ def write_table(path, rows, args):
         ("touched_beam", "touched the beam"),
         ("residence_mean_s", "residence mean (s)"),
         ("residence_median_s", "median (s)"),
-        ("plate_impacts_per_lump", "plate impacts per lump"),
+        ("plate_impacts_per_lump", "plate contact records per lump"),
         ("on_beam_end", "on the beam at the end"),
         ("at_rest_end", "of them at rest"),
         ("S1_rms", "S1 RMS (m/s²)"),
