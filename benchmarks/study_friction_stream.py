@@ -10,7 +10,9 @@ frictionless and with friction on every contact:
   the range DEM studies give to rounded rock lumps; below tan 30 deg = 0.58, so a single
   sphere keeps rolling down the beam);
 * ``mu=0.7 mu_r=0.7``: rolling resistance above tan 30 deg, standing in for lumps far from
-  round: a single lump stops on the beam, later lumps strike the ones at rest.
+  round: a single rolling lump decelerates on the beam;
+* ``low drop, frictionless`` and ``low drop, mu=0.7 mu_r=0.7``: the same stream released
+  20-100 mm above the plate, where lumps land slowly enough to roll and stop on the beam.
 
 Stiction velocity 1e-3 m/s, transition velocity 2e-3 m/s (friction.md: creep below 1 mm/s).
 
@@ -22,7 +24,7 @@ forces only). Per case:
 
 * residence time on the beam: from a lump's first plate contact to its leaving over an edge
   (lumps still on the beam at the end are counted apart);
-* plate impacts per lump that touched the beam (contact records with the plate);
+* plate contact records per lump that touched the beam;
 * lumps on the beam at the end, and how many of them are at rest (centre speed < 1 cm/s);
 * in-band RMS of each sensor over the run and its Welch spectrum;
 * how much of the coal / gangue difference survives: the area under the ROC curve (AUC, 0.5 =
