@@ -52,6 +52,8 @@ from tailbeam.solvers.stream.active.compiled.friction import (
     IMP_N,
     IMP_T,
     IMP_WORK,
+    F_GRAD,
+    F_LEVER,
     pair_friction,
     spin_offset,
 )
@@ -145,7 +147,8 @@ def _impulses(h, p, dense, pts, vinv, model, forces, imp, tmp):
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     coef, y0 = dense[2], dense[3]
     n = mass.shape[0]
-    off = spin_offset(n, omega.shape[0])
+    nm = omega.shape[0]
+    off = spin_offset(n, nm)
     i, j = pi[p], pj[p]
     for q in range(pts.shape[0]):
         s = pts[q]
@@ -155,6 +158,9 @@ def _impulses(h, p, dense, pts, vinv, model, forces, imp, tmp):
             for k in range(3):
                 for base in (3 * b, 3 * n + 3 * b, off + 3 * b):
                     tmp[base + k] = dense_component(coef, y0, s, base + k)
+        if j < 0 and fric.shape[1] > F_GRAD and fric[p, F_LEVER] != 0.0:
+            for k in range(6 * n + nm, 6 * n + 2 * nm):  # the modal rates (surface velocity)
+                tmp[k] = dense_component(coef, y0, s, k)
         _, _, nx, ny, nz = pair_state(tmp, n, i, j, rsum[p], phi, p)
         r = pair_friction(tmp, n, off, i, j, p, nx, ny, nz, forces[q], fric)
         wq = cc_weight(vinv, q) * h
