@@ -20,6 +20,7 @@ from tailbeam.physics.contact_law import law_table
 from tailbeam.physics.contacts import PLATE
 from tailbeam.physics.incline import EDGES
 from tailbeam.results.records import EventCode
+from tailbeam.solvers.stream.active import friction_pairs
 from tailbeam.solvers.stream.active.carry import CarriedRows
 from tailbeam.solvers.stream.active.compiled.pairs import first_contact_step
 from tailbeam.solvers.stream.active.forces import PlateForces
@@ -71,7 +72,7 @@ class ActiveMembers:
         self.plate = plate
         self.settle_energy = settle_energy
         self.modal = None if plate is None else PlatePairs(plate, balls, rtol, dead_loads)
-        self.forces = PlateForces()
+        self.forces = PlateForces(self._friction_lever())
         self.carried = CarriedRows()
         self.now = 0.0
         self.members, self.quiet = [], set()  # quiet: members resting on the plate
@@ -84,6 +85,13 @@ class ActiveMembers:
             ("kernel_steps", "kernel_attempts", "kernel_nfev", "rebuilds", "events_found_again"),
             0,
         )
+
+    def _friction_lever(self) -> float:
+        """h/2 (m) where friction's moment drives the modal plate (its loads for the
+        sensors, ``forces``), else 0."""
+        if self.friction is None or self.plate is None or not friction_pairs._PLATE_MOMENT:
+            return 0.0
+        return 0.5 * self.plate.basis.plate.thickness
 
     # --- membership and rebuilds ------------------------------------------------------------
     def add(self, i: int, x, v, *, quiet: bool):

@@ -158,9 +158,9 @@ def solve_stream(
     friction : FrictionModel, optional
         Friction and rolling resistance of every contact, the balls' rotation
         (``tailbeam.physics.friction``; on the modal plate also between the balls and the
-        plate's top surface, the force's moment driving the modes). None: frictionless. With friction
-        no contact is put at rest (``rest_speed`` and SETTLE unused): a ball on the plate is
-        integrated for as long as it touches it.
+        plate's top surface, the force's moment driving the modes). None: frictionless.
+        With friction no contact is put at rest (``rest_speed`` and SETTLE unused): a ball
+        on the plate is integrated for as long as it touches it.
 
     Returns
     -------
