@@ -12,8 +12,8 @@ each following one protocol (``tailbeam.solvers.base.Solver``):
 - ``"stream-reference"``: the slow independent reference of the stream solver (scipy DOP853,
   every pair watched, at most ``REFERENCE_MAX_PARTICLES`` bodies), on the rigid plate;
 - ``"auto"`` (the default): ``"single-ball"`` where it can run, else ``"stream"``; a scene
-  with friction (``[contact.friction]``): ``"stream"`` on the rigid plate (it and
-  ``"stream-reference"`` model friction there), else refused.
+  with friction (``[contact.friction]``): ``"stream"`` (rigid or modal plate; on the rigid
+  plate ``"stream-reference"`` models it too).
 
 Running one scene through two solvers is how a user checks one against the other.
 """

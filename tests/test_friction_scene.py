@@ -95,12 +95,14 @@ def test_single_ball_refuses_friction_and_auto_picks_the_fast_stream_solver():
     assert choose_solver(scene, "stream", "--solver").name == "stream"
     assert choose_solver(scene).name == "stream"
     modal = loads_scene(BASE + FRICTION + "[plate]\nmodel = 'modal'\n")
+    assert choose_solver(modal).name == "stream"
+    assert choose_solver(modal, "stream", "--solver").name == "stream"
     with pytest.raises(InputError) as err:
-        choose_solver(modal)
-    assert err.value.field == "contact.friction" and "rigid" in str(err.value)
+        choose_solver(modal, "single-ball", "--solver")
+    assert err.value.field == "--solver" and "contact.friction" in str(err.value)
     with pytest.raises(InputError) as err:
-        choose_solver(modal, "stream", "--solver")
-    assert "contact.friction" in str(err.value)
+        choose_solver(modal, "stream-reference", "--solver")
+    assert err.value.field == "--solver" and "rigid" in str(err.value)
     crowd = (
         BASE
         + FRICTION

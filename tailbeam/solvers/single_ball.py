@@ -24,7 +24,8 @@ class SingleBall(Solver):
         if scene.friction is not None:
             return (
                 "contact.friction: 'single-ball' models frictionless contacts only; friction "
-                "and rotation run on --solver stream or stream-reference (rigid plate)"
+                "and rotation run on --solver stream (rigid or modal plate) or stream-reference "
+                "(rigid plate)"
             )
         if not scene.needs_stream_solver:
             return None

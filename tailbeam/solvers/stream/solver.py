@@ -37,10 +37,6 @@ REFERENCE_RTOL = 1e-10
 # (examples/small_stream.toml: 1082 steps); it grows ~N^2 (all pairs).
 REFERENCE_STEP_SECONDS = 3e-3
 REFERENCE_STEP_PARTICLES = 12
-FRICTION_REFUSAL = (
-    "contact.friction: '{name}' runs friction and rotation on the rigid plate only "
-    '(plate.model = "rigid"); remove [contact.friction] to run this plate frictionless'
-)
 
 
 class Stream(Solver):
@@ -52,11 +48,6 @@ class Stream(Solver):
     label = "fast stream solver"
     max_particles = MAX_PARTICLES
     rtol, max_steps = DEFAULT_RTOL, DEFAULT_MAX_STEPS
-
-    def refusal(self, scene) -> str | None:
-        if scene.friction is None or scene.plate_model == "rigid":
-            return None
-        return FRICTION_REFUSAL.format(name=self.name)
 
     def estimate(self, n_particles: int, max_steps: int) -> tuple[float, float]:
         """Upper-bound-style estimates (bytes, s): per particle ~30 contact records and force
@@ -112,7 +103,8 @@ class StreamReference(Stream):
         if scene.plate_model == "rigid":
             return None
         return (
-            "'stream-reference' runs on the rigid plate (plate.model = \"rigid\"); its modal "
+            "'stream-reference' runs on the rigid plate (plate.model = \"rigid\"), with or "
+            "without friction; its modal "
             "plate (tailbeam.solvers.stream.reference.plate) has no residual flexibility or "
             "sensors, and is used by the tests"
         )
@@ -172,8 +164,8 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
     frames : sequence of float
         Frame times (s): every ball's state there goes to the result's ``frames``.
     friction : FrictionModel, optional
-        Friction, rolling resistance and the balls' rotation (rigid plate,
-        ``solve_stream``); None: frictionless.
+        Friction, rolling resistance and the balls' rotation (``solve_stream``; on the
+        two-way modal plate the force's moment drives the modes); None: frictionless.
     """
     run = solve_stream(
         particles, incline, duration, rtol=rtol, rest_speed=rest_speed, max_work=max_steps,

@@ -4,16 +4,34 @@ The compiled set writes force rows (t, pair, F) of its touching plate pairs: at 
 points of every accepted step and at contact starts and ends. They are drained after each
 ``advance`` into one history per ball, held at the point of its first row, until the driver
 takes it as a load (a contact ended, the ball left the set or the run ended).
+
+With friction on the modal plate the set also writes the friction force F_t on the ball
+(rows (t, pair + P, F_x) and (t, pair + 2 P, F_y), P the set's pairs). The plate takes -F_t
+on its top surface, h/2 above its mid-surface: the modes feel (h/2) F_t . grad phi
+(``compiled.friction``). For the sensors that moment is a couple of point loads, in x
++/-(h/2) F_x / (2 e) at x -/+ e and the same in y (e = ``COUPLE_STEP``): its modal forces
+are (h/2) F_t . grad phi with grad phi a central difference of step e (relative error
+~(k e)^2 / 6 for a mode of wavenumber k, as ``StreamPlate.gradients``).
 """
 
 import numpy as np
 
+COUPLE_STEP = 1e-5  # m, half the distance between the two point loads of a couple
+
 
 class PlateForces:
-    """Force histories by ball: the point (x, y) in m and pieces of (t s, F N) rows."""
+    """Force histories by ball: the point (x, y) in m and pieces of (t s, F N) rows, and
+    with friction on the modal plate its friction force's rows.
 
-    def __init__(self):
-        self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays]]
+    Parameters
+    ----------
+    lever : float
+        h/2 (m): the friction force's lever on the modal plate (0: its moment is not a load).
+    """
+
+    def __init__(self, lever: float = 0.0):
+        self.lever = float(lever)
+        self.nodes = {}  # ball -> [x, y, [t arrays], [F arrays], [t], [F_x], [F_y]]
 
     def drain(self, s, keys, local) -> None:
         """Move the force rows of ``s`` (an ``ActiveSet``) into the histories.
@@ -30,32 +48,56 @@ class PlateForces:
         rows = s.force_rows()
         if not len(rows):
             return
-        pairs = rows[:, 1].astype(np.int64)
-        for p in np.unique(pairs):
+        codes = rows[:, 1].astype(np.int64)
+        npairs = len(keys)
+        for code in np.unique(codes):
+            p, part = code % npairs, code // npairs
             i = keys[p][0]
-            sel = rows[pairs == p]
+            sel = rows[codes == code]
             entry = self.nodes.get(i)
             if entry is None:
                 x = s.x[local[i]]
-                entry = self.nodes[i] = [float(x[0]), float(x[1]), [], []]
-            entry[2].append(sel[:, 0].copy())
-            entry[3].append(sel[:, 2].copy())
+                entry = self.nodes[i] = [float(x[0]), float(x[1]), [], [], [], [], []]
+            if part == 0:
+                entry[2].append(sel[:, 0].copy())
+                entry[3].append(sel[:, 2].copy())
+            else:  # friction rows: x then y, at the same times
+                if part == 1:
+                    entry[4].append(sel[:, 0].copy())
+                entry[4 + part].append(sel[:, 2].copy())
 
-    def take(self, i: int):
-        """Ball i's plate force since the last take.
+    def take(self, i: int) -> list:
+        """Ball i's plate loads since the last take: its force, and with friction on the
+        modal plate the four point loads of its friction's couples (module docstring).
 
         Returns
         -------
-        tuple or None
-            (x m, y m, t_nodes (k,) s, forces (k,) N) in time order, or None when there is
-            none or it spans a single instant (a contact flushed as it started).
+        list of tuple
+            (x m, y m, t_nodes (k,) s, forces (k,) N) in time order, none for a history that
+            is empty or spans a single instant (a contact flushed as it started).
         """
         entry = self.nodes.pop(i, None)
         if entry is None:
-            return None
-        t = np.concatenate(entry[2])
-        f = np.concatenate(entry[3])
-        order = np.argsort(t, kind="stable")
-        if not t[order[-1]] > t[order[0]]:
-            return None
-        return entry[0], entry[1], t[order], f[order]
+            return []
+        x, y = entry[0], entry[1]
+        out = _piece(x, y, entry[2], entry[3])
+        if self.lever > 0.0 and entry[4]:
+            e = COUPLE_STEP
+            scale = self.lever / (2.0 * e)
+            for dx, dy, part in ((e, 0.0, entry[5]), (0.0, e, entry[6])):
+                force = [-scale * f for f in part]
+                out += _piece(x + dx, y + dy, entry[4], force)
+                out += _piece(x - dx, y - dy, entry[4], [-f for f in force])
+        return out
+
+
+def _piece(x, y, times, forces) -> list:
+    """[(x, y, t, F)] in time order, or [] when empty or spanning a single instant."""
+    if not times:
+        return []
+    t = np.concatenate(times)
+    f = np.concatenate(forces)
+    order = np.argsort(t, kind="stable")
+    if not t[order[-1]] > t[order[0]]:
+        return []
+    return [(x, y, t[order], f[order])]

@@ -20,6 +20,7 @@ from tailbeam.physics.contact_law import law_table
 from tailbeam.physics.contacts import PLATE
 from tailbeam.physics.incline import EDGES
 from tailbeam.results.records import EventCode
+from tailbeam.solvers.stream.active import friction_pairs
 from tailbeam.solvers.stream.active.carry import CarriedRows
 from tailbeam.solvers.stream.active.compiled.pairs import first_contact_step
 from tailbeam.solvers.stream.active.forces import PlateForces
@@ -46,7 +47,8 @@ class ActiveMembers:
         () -> (xy (p, 2) m, weights (p,) N) of the balls resting on the plate outside the
         set (modal plate).
     friction : FrictionPairs, optional
-        The pairs' friction (``friction_pairs``; rigid plate): the sets integrate the
+        The pairs' friction (``friction_pairs``; on the modal plate with the slip against
+        the plate's surface and the moment into the modes): the sets integrate the
         members' angular velocities (``balls.w`` holds them while a ball is not in a built
         set). None: frictionless.
 
@@ -70,7 +72,7 @@ class ActiveMembers:
         self.plate = plate
         self.settle_energy = settle_energy
         self.modal = None if plate is None else PlatePairs(plate, balls, rtol, dead_loads)
-        self.forces = PlateForces()
+        self.forces = PlateForces(self._friction_lever())
         self.carried = CarriedRows()
         self.now = 0.0
         self.members, self.quiet = [], set()  # quiet: members resting on the plate
@@ -83,6 +85,13 @@ class ActiveMembers:
             ("kernel_steps", "kernel_attempts", "kernel_nfev", "rebuilds", "events_found_again"),
             0,
         )
+
+    def _friction_lever(self) -> float:
+        """h/2 (m) where friction's moment drives the modal plate (its loads for the
+        sensors, ``forces``), else 0."""
+        if self.friction is None or self.plate is None or not friction_pairs._PLATE_MOMENT:
+            return 0.0
+        return 0.5 * self.plate.basis.plate.thickness
 
     # --- membership and rebuilds ------------------------------------------------------------
     def add(self, i: int, x, v, *, quiet: bool):
@@ -158,7 +167,8 @@ class ActiveMembers:
         modal = {} if self.modal is None else self.modal.block(m, self.keys, self._x,
                                                                 self.quiet, self.now)  # fmt: skip
         if self.friction is not None:
-            modal = {**modal, "friction": self.friction.table(self.keys), "w": b.w[m]}
+            table = self.friction.table(self.keys, **self._plate_friction(modal))
+            modal = {**modal, "friction": table, "w": b.w[m]}
         self.set = s = ActiveSet(
             [self._x[i] for i in m], [self._v[i] for i in m], b.mass[m], b.radius[m],
             np.array(pairs, dtype=np.int64).reshape(-1, 2), law_table(laws), b.g, b.half,
@@ -174,6 +184,26 @@ class ActiveMembers:
             self.carried.restore(s, local, self.index)
         self.dirty = False
         self.totals["rebuilds"] += 1
+
+    def _plate_friction(self, modal) -> dict:
+        """With friction on the modal plate: what the friction table of a set rebuilt with the
+        modal inputs ``modal`` takes for its plate pairs (``FrictionPairs.table``)."""
+        if self.modal is None:
+            return {}
+        grads = {k: self.modal.gradient(k) for k in self.keys if k[1] < 0}
+        half = 0.5 * self.plate.basis.plate.thickness
+        return dict(gradients=grads, n_modes=modal["phi"].shape[1], half=half)
+
+    def surface_velocity(self, key):
+        """With friction on the modal plate: the in-plane velocity (3,) m/s of the plate's top
+        surface at plate pair ``key``'s contact point now, -(h/2) grad phi . q' (None on the
+        rigid plate)."""
+        if self.modal is None or key[1] >= 0:
+            return None
+        s, n = self._ready(), self.plate.n_modes
+        out = np.zeros(3)
+        out[:2] = -0.5 * self.plate.basis.plate.thickness * (s.qd[:n] @ self.modal.gradient(key))
+        return out
 
     def _count(self):
         """Add the work counters of the built set to the totals (and reset them there)."""
@@ -334,8 +364,12 @@ class ActiveMembers:
         free = [(q, i) for q, i in enumerate(self.members) if not touching[self.index[(i, -1)]]]
         if not free:
             return
-        for key in self.modal.refresh(s, free, self.index):  # (after the set's own changes:
-            self._drop_tail(key)  # dropping syncs and rebuilds it)
+        moved = self.modal.refresh(s, free, self.index)
+        if self.friction is not None:  # the friction table's shape gradients follow the shapes
+            for key in moved:
+                s.model.set_gradients(self.index[key], self.modal.gradient(key))
+        for key in moved:  # (after the set's own changes: dropping syncs and rebuilds it)
+            self._drop_tail(key)
 
     def _set_compliance(self, key):
         """Modal plate: plate pair ``key`` (touching from now) gets its tail (``_start_tail``)

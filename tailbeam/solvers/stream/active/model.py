@@ -13,7 +13,7 @@ import numpy as np
 
 from tailbeam.errors import InputError
 from tailbeam.physics.contact_law import LAW_COLUMNS, law_table
-from tailbeam.solvers.stream.active.compiled.friction import F_COLUMNS
+from tailbeam.solvers.stream.active.compiled.friction import F_COLUMNS, F_GRAD
 from tailbeam.solvers.stream.active.compiled.pairs import L_CRES
 
 
@@ -41,8 +41,9 @@ class Model:
         None: 0).
     modes : ModalBlock
         The modal plate's modes (``modal_block``; none on the rigid plate).
-    friction : array_like, shape (P, F_COLUMNS), optional
-        The pairs' friction table (``compiled.friction``); None: frictionless.
+    friction : array_like, shape (P, F_COLUMNS) or (P, F_GRAD + 2 m), optional
+        The pairs' friction table (``compiled.friction``; on the modal plate with the levers
+        and shape gradients); None: frictionless.
 
     Attributes
     ----------
@@ -67,8 +68,9 @@ class Model:
         Modal frequencies (rad/s), damping ratios, constant modal forces (N/sqrt(kg)).
     phi : ndarray, shape (P, m)
         Mode shapes (1/sqrt(kg)) at each plate pair's contact point.
-    fric : ndarray, shape (P, F_COLUMNS) or (P, 0)
-        The friction table (no columns: frictionless).
+    fric : ndarray, shape (P, F_COLUMNS) or (P, F_GRAD + 2 m) or (P, 0)
+        The friction table (modal plate: with the levers and shape gradients; no columns:
+        frictionless).
     """
 
     def __init__(self, n, mass, radius, pairs, laws, gravity, half_sizes, settle_energy,
@@ -94,7 +96,7 @@ class Model:
         self.alive = np.ones(n, dtype=bool)
         self.omega, self.zeta = modes.omega, modes.zeta
         self.phi, self.f_dead = modes.phi, modes.f_dead
-        self.fric = _friction_table(friction, len(self.pi))
+        self.fric = _friction_table(friction, len(self.pi), self.omega.shape[0])
 
     @property
     def friction(self) -> bool:
@@ -118,6 +120,16 @@ class Model:
             raise InputError("compliance", f"must be finite and >= 0 m/N, got {value!r}")
         self.law[p, L_CRES] = value
 
+    def set_gradients(self, p: int, grad) -> None:
+        """Gradients (m, 2) 1/(m sqrt(kg)) of the mode shapes at plate pair p's new contact
+        point (before it touches), into a modal friction table."""
+        if self.fric.shape[1] > F_GRAD:
+            m = (self.fric.shape[1] - F_GRAD) // 2
+            grad = np.asarray(grad, dtype=float).reshape(-1, 2)
+            self.fric[p, F_GRAD:] = 0.0
+            self.fric[p, F_GRAD : F_GRAD + len(grad)] = grad[:, 0]
+            self.fric[p, F_GRAD + m : F_GRAD + m + len(grad)] = grad[:, 1]
+
 
 def _with_compliance(laws, pj, compliance) -> np.ndarray:
     """(P, L_CRES + 1) law table: a (P, LAW_COLUMNS) ``law_table`` and the residual
@@ -133,11 +145,19 @@ def _with_compliance(laws, pj, compliance) -> np.ndarray:
     return np.ascontiguousarray(np.column_stack([laws, np.where(pj < 0, cres, 0.0)]))
 
 
-def _friction_table(friction, n_pairs) -> np.ndarray:
-    """(P, F_COLUMNS) friction table (``compiled.friction``), or (P, 0) without friction."""
+def _friction_table(friction, n_pairs, n_modes) -> np.ndarray:
+    """(P, F_COLUMNS) friction table (``compiled.friction``), on the modal plate possibly
+    (P, F_GRAD + 2 n_modes) (the levers and shape gradients), or (P, 0) without friction."""
     if friction is None:
         return np.zeros((n_pairs, 0))
-    table = np.ascontiguousarray(np.asarray(friction, dtype=float).reshape(-1, F_COLUMNS))
+    table = np.asarray(friction, dtype=float)
+    width = table.shape[-1] if table.ndim == 2 else F_COLUMNS
+    if width not in (F_COLUMNS, F_GRAD + 2 * n_modes):
+        raise InputError(
+            "friction", f"{F_COLUMNS} columns, or {F_GRAD + 2 * n_modes} with the modal plate's "
+            f"{n_modes} modes; got {width}"
+        )  # fmt: skip
+    table = np.ascontiguousarray(table.reshape(-1, width))
     if table.shape[0] != n_pairs:
         raise InputError("friction", f"one row per pair: got {table.shape[0]} for {n_pairs}")
     return table

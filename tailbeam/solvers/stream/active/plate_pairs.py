@@ -43,6 +43,7 @@ class PlatePairs:
         self.load_radii = {}  # ball -> radius (m) of its load model (contact_patch)
         self.kept_phi = {}  # plate pair key -> its mode shapes in the last built set
         self.kept_cres = {}  # plate pair key -> its compliance (m/N) in the last built set
+        self.grads = {}  # plate pair key -> (point, its shapes' gradients) (with friction)
 
     def save(self, s, index) -> None:
         """Keep the shapes, compliance and tail states of the plate pairs of ``s`` (the built
@@ -117,6 +118,15 @@ class PlatePairs:
                 self.points[(i, -1)] = xy
                 moved.append((i, -1))
         return moved
+
+    def gradient(self, key) -> np.ndarray:
+        """Gradients (m, 2) 1/(m sqrt(kg)) of the plate's mode shapes at the point of plate
+        pair ``key``'s shapes (``StreamPlate.gradients``; kept while the point is)."""
+        point = tuple(self.points[key])
+        kept = self.grads.get(key)
+        if kept is None or kept[0] != point:
+            kept = self.grads[key] = (point, self.plate.gradients([point])[0])
+        return kept[1]
 
     def deflection(self, s, p: int) -> tuple[float, float]:
         """Deflection (m) and its rate (m/s) of the plate's modes under plate pair p of ``s``

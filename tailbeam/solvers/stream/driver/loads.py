@@ -26,9 +26,7 @@ class PlateLoads:
 
     def flush(self, i: int) -> None:
         """Hand the plate force history of ball i recorded so far to the loads."""
-        piece = self.forces.take(i)
-        if piece is not None:
-            self.loads.append(piece)
+        self.loads.extend(self.forces.take(i))
 
     def dead_load(self, i: int, t_to: float) -> None:
         """Ball i slid from ``slide_since`` to t_to (s): its weight as constant loads on

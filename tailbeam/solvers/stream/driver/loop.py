@@ -157,9 +157,10 @@ def solve_stream(
         agrees with one without to the tolerance ``rtol``, not bit for bit.
     friction : FrictionModel, optional
         Friction and rolling resistance of every contact, the balls' rotation
-        (``tailbeam.physics.friction``; rigid plate only). None: frictionless. With friction
-        no contact is put at rest (``rest_speed`` and SETTLE unused): a ball on the plate is
-        integrated for as long as it touches it.
+        (``tailbeam.physics.friction``; on the modal plate also between the balls and the
+        plate's top surface, the force's moment driving the modes). None: frictionless.
+        With friction no contact is put at rest (``rest_speed`` and SETTLE unused): a ball
+        on the plate is integrated for as long as it touches it.
 
     Returns
     -------
@@ -175,9 +176,6 @@ def solve_stream(
     if contacts is None:
         contacts = LawOptions(exponent, damping, penetration, clamp)
     contacts = contact_table(particles, contacts, incline.plate.material)
-    if friction is not None and plate is not None:
-        raise InputError("contact.friction", "the fast stream solver runs friction on the "
-                         "rigid plate only (plate.model = \"rigid\")")  # fmt: skip
     for attempt in range(GRAZING_RETRIES + 1):
         if plate is not None:
             plate.reset()

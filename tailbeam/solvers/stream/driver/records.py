@@ -105,7 +105,8 @@ class ContactRecords:
         i, j = key
         xi, vi = act.state(i)
         partner = (None, None, None) if j < 0 else (*act.state(j), act.spin(j))
-        end = act.friction.end(key, xi, vi, act.spin(i), *partner)
+        end = act.friction.end(key, xi, vi, act.spin(i), *partner,
+                               surface=act.surface_velocity(key))  # fmt: skip
         tangential = float(np.linalg.norm(imp[IMP_T : IMP_T + 3]))
         for rec in recs:
             rec.normal_impulse, rec.tangential_impulse = float(imp[IMP_N]), tangential

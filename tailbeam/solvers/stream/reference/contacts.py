@@ -54,10 +54,10 @@ class ContactLog:
                        t_start=t, x=point[0], y=point[1], v_in=float(v[lj] @ n),
                        approach_in=rate)
             )  # fmt: skip
-        phi0 = None
+        phi0 = grad0 = None
         if pair.j < 0 and self.plate is not None and self.plate.frozen:
-            phi0 = self.plate.shapes_at(x_i[:2])[0]
-        pair.start(records, float(kin.penetration[0]), phi0)
+            phi0, grad0 = (a[0] for a in self.plate.shapes_and_gradients(x_i[:2]))
+        pair.start(records, float(kin.penetration[0]), phi0, grad0)
         self.contacts.extend(records)
         self.log(t, EventKind.CONTACT_START, pair)
 

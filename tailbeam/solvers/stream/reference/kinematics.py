@@ -26,6 +26,9 @@ class PairIndex:
     frozen_phi : ndarray or None
         (P, m) mode shapes kept by frozen plate contacts, NaN rows where the shapes are
         evaluated exactly; None on the rigid plate.
+    frozen_grad : ndarray or None
+        (P, m, 2) their gradients (friction's lever on the plate's surface), zero rows where
+        the shapes are evaluated exactly; None on the rigid plate.
     """
 
     li: np.ndarray
@@ -33,6 +36,7 @@ class PairIndex:
     is_plate: np.ndarray
     radius_sum: np.ndarray
     frozen_phi: np.ndarray | None = None
+    frozen_grad: np.ndarray | None = None
 
 
 class Kinematics:
@@ -56,13 +60,15 @@ class Kinematics:
         li = loc[[p.i for p in pairs]]
         lj = loc[[max(p.j, 0) for p in pairs]]
         is_plate = np.array([p.j < 0 for p in pairs], dtype=bool)
-        frozen = None
+        frozen = grads = None
         if self.plate is not None:
             frozen = np.full((len(pairs), self.plate.n_modes), np.nan)
+            grads = np.zeros((len(pairs), self.plate.n_modes, 2))
             for k, p in enumerate(pairs):
                 if p.phi0 is not None:
-                    frozen[k] = p.phi0
-        return PairIndex(li, lj, is_plate, np.array([p.radius_sum for p in pairs]), frozen)
+                    frozen[k], grads[k] = p.phi0, p.grad0
+        rsum = np.array([p.radius_sum for p in pairs])
+        return PairIndex(li, lj, is_plate, rsum, frozen, grads)
 
     def of(self, pairs, x, v, modes=None):
         """Kinematics of ``pairs`` (a list or its ``index``) at positions x (m) and
@@ -99,12 +105,16 @@ class Kinematics:
     def modal(self, pairs, x, v, modes):
         """``of`` on the modal plate: the plate pairs' penetration and rate against the
         deflected plate; also returns their slope (P', 2), shapes (P', m) and the shapes'
-        gradients (P', m, 2), flattened over the leading axes as the kinematics."""
+        gradients (P', m, 2) (a frozen contact's kept ones: no slope term, but friction's
+        lever), flattened over the leading axes as the kinematics."""
         ix = pairs if isinstance(pairs, PairIndex) else self.index(pairs)
         kin, li, lj, is_plate, xi, vi, rsum = self.rigid(ix, x, v)
         gap, rate, slope, phi, grad = self.plate.contact_geometry(
             xi, vi, is_plate, ix.frozen_phi, modes
         )
+        kept = ~np.isnan(ix.frozen_phi[:, 0]) if self.plate.n_modes else is_plate & False
+        if np.any(kept):  # a frozen contact's lever for friction: the gradients it kept
+            grad[..., kept, :, :] = ix.frozen_grad[kept]
         flat = np.broadcast_to(is_plate, rsum.shape).reshape(-1)
         kin = replace(
             kin,

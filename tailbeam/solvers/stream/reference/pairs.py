@@ -32,6 +32,8 @@ class Pair:
         The open contact's largest force (N), its time (s) and largest penetration (m).
     phi0 : ndarray or None
         Mode shapes (1/sqrt(kg)) kept by a frozen plate contact (modal plate), else None.
+    grad0 : ndarray or None
+        Their gradients (m, 2) 1/(m sqrt(kg)), kept with them (friction's lever), else None.
     friction : FrictionSettings or None
         The pair's friction (``tailbeam.physics.friction``); None: frictionless.
     share : float
@@ -55,6 +57,7 @@ class Pair:
     t_peak: float = math.nan
     pen: float = 0.0
     phi0: np.ndarray | None = None
+    grad0: np.ndarray | None = None
     friction: object = None
     share: float = 1.0
     normal_impulse: float = 0.0
@@ -65,20 +68,20 @@ class Pair:
         """Whether the law has a STEP kink at delta = d (it does only with damping)."""
         return self.law.damping > 0.0
 
-    def start(self, records, penetration, phi0=None) -> None:
+    def start(self, records, penetration, phi0=None, grad0=None) -> None:
         """Open a contact with its ``records`` (``Impact``, one per ball) at ``penetration``
         (m; 0 if negative), in the ramp region, unclamped; ``phi0``: the mode shapes a
         frozen plate contact keeps."""
         self.in_contact, self.ramp, self.clamped = True, True, False
         self.peak, self.t_peak, self.pen = 0.0, math.nan, max(0.0, penetration)
-        self.records, self.phi0 = records, phi0
+        self.records, self.phi0, self.grad0 = records, phi0, grad0
         self.normal_impulse, self.tangential_impulse = 0.0, np.zeros(3)
 
     def stop(self, slip=math.nan) -> None:
         """Close the contact: its peaks go into its records, which it then lets go. ``slip``:
         the slip speed at the end (m/s; ``write_peaks``)."""
         self.write_peaks(slip)
-        self.in_contact, self.records, self.phi0 = False, [], None
+        self.in_contact, self.records, self.phi0, self.grad0 = False, [], None, None
 
     def write_peaks(self, slip=math.nan) -> None:
         """Copy the peak force, its time, the largest penetration and the impulses into the

@@ -27,8 +27,9 @@ Mode shapes (``shapes``):
   slope term (the fast solver's contact model: ``tailbeam.solvers.stream.active.compiled.pairs``);
   before a touch the gap is exact. Comparing both variants measures what freezing costs.
 
-Friction (``friction=`` of the reference, exact shapes only). The friction force F_t on a ball
-acts, reversed, on the plate's top surface, h/2 above its mid-surface, whose in-plane
+Friction (``friction=`` of the reference; with frozen shapes a contact keeps the
+gradients of its first touch with its shapes, as the fast solver does). The friction force
+F_t on a ball acts, reversed, on the plate's top surface, h/2 above its mid-surface, whose in-plane
 displacement is -(h/2) grad w (Kirchhoff): the modes feel the generalised force
 (h/2) F_t . grad phi, and the slip is measured against the surface's in-plane velocity
 -(h/2) grad phi . q'. The plate then takes exactly the power the ball gives up less what

@@ -30,7 +30,8 @@ The parts, each given the others it uses when it is made (``_simulate`` wires th
 * ``steps.StepSeries``: what an accepted step records (peaks, energy, states);
 * ``loop.StepLoop``: drives DOP853 (``loop.Integrator``) from event to event.
 
-Friction (``friction=FrictionModel``, rigid plate). The state gains every ball's angular
+Friction (``friction=FrictionModel``; on the modal plate with exact or frozen shapes, a
+frozen contact keeping its shapes' gradients too: ``plate``). The state gains every ball's angular
 velocity (moment of inertia 2/5 m r^2). The regularised Adams law is smooth (C^1 in the slip
 velocity), so it needs no event of its own: DOP853 resolves its stiffness by short steps.
 That is the honest cost of the slow truth: with a contact held at slip speeds below v_s the
@@ -193,7 +194,7 @@ def simulate_stream_reference(
         The balls' contact table; its settings then replace the IMPACT parameters above.
     friction : FrictionModel, optional
         Friction and rolling resistance of every contact (``tailbeam.physics.friction``;
-        rigid plate only); None: frictionless, the balls' angular velocities never change.
+        rigid or modal plate); None: frictionless, the balls' angular velocities never change.
 
     Returns
     -------
@@ -210,11 +211,6 @@ def simulate_stream_reference(
             raise InputError("plate", "must be a ReferencePlate (a modal basis and its damping)")
         plate.check_size(incline)
         _check_modal_work(plate, duration, max_steps)
-        if friction is not None and plate.frozen:
-            raise InputError(
-                "contact.friction", "friction on the stream reference's modal plate needs "
-                'exact mode shapes (ReferencePlate(..., shapes="exact"))'
-            )  # fmt: skip
     if friction is not None and not isinstance(friction, FrictionModel):
         raise InputError("contact.friction", "must be a FrictionModel (or None: frictionless)")
     _check_balls(balls, incline)

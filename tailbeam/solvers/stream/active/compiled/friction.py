@@ -13,6 +13,14 @@ a_j = d (1 - share) n, slip = u - (u . n) n with u = (v_i + w_i x a_i) - (v_j + 
 the tangential force F_t (on i, -F_t on j) has the torques a_i x F_t on i and -a_j x F_t
 on j; rolling resistance acts against w_roll, the part of w_i - w_j in the contact plane.
 The power dissipated, -(F_t . slip) - (tau . w_roll), is >= 0.
+
+On the modal plate (the reference's model, ``tailbeam.solvers.stream.reference.plate``) a
+plate pair's table row goes on with F_LEVER, F_MOMENT and the gradients of the m mode
+shapes at its contact point (d phi / dx for the m modes, then d phi / dy; 1/(m sqrt(kg))):
+the plate's top surface, h/2 above its mid-surface, moves in-plane at -(h/2) grad phi . q'
+(Kirchhoff), which the slip is taken against (lever F_LEVER = h/2), and the force -F_t it
+takes there gives the modes the generalised force (h/2) F_t . grad phi (lever F_MOMENT =
+h/2; 0 leaves the moment out). Rows of ball-ball pairs and the rigid plate have both levers 0.
 """
 
 import math
@@ -23,6 +31,8 @@ from tailbeam.solvers.numerics.jit import helper_njit
 # friction table columns: mu_s, mu_d, v_s (m/s), v_d (m/s), mu_r, share, rolling radius (m)
 F_STATIC, F_DYNAMIC, F_VS, F_VD, F_ROLL, F_SHARE, F_RADIUS = range(7)
 F_COLUMNS = 7
+# modal plate: surface and moment levers (m), then the shapes' gradients (2 m columns)
+F_LEVER, F_MOMENT, F_GRAD = 7, 8, 9
 # pair accumulators ``imp`` (P, IMP_COLUMNS): normal impulse (N s), tangential impulse on
 # ball i (3, N s), energy dissipated by friction and rolling resistance (J)
 IMP_N, IMP_T, IMP_WORK = 0, 1, 4
@@ -59,6 +69,8 @@ def pair_friction(y, n, off, i, j, p, nx, ny, nz, fn, fric):
     else:
         d = abs(y[xi + 2])
         vjx, vjy, vjz, wjx, wjy, wjz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if fric.shape[1] > F_GRAD and fric[p, F_LEVER] != 0.0:
+            vjx, vjy = surface_velocity(y, n, p, fric)
     ai, aj = -d * share, d * (1.0 - share)  # lever arms along n
     wix, wiy, wiz = y[wi], y[wi + 1], y[wi + 2]
     # u = v_i + w_i x (ai n) - v_j - w_j x (aj n)
@@ -87,9 +99,36 @@ def pair_friction(y, n, off, i, j, p, nx, ny, nz, fn, fric):
 
 
 @helper_njit
+def surface_velocity(y, n, p, fric):
+    """In-plane velocity (m/s) of the plate's top surface at plate pair p's contact point:
+    -lever grad phi . q' (modal table row, module docstring)."""
+    nm = (fric.shape[1] - F_GRAD) // 2
+    off = 6 * n + nm
+    sx, sy = 0.0, 0.0
+    for k in range(nm):
+        sx += fric[p, F_GRAD + k] * y[off + k]
+        sy += fric[p, F_GRAD + nm + k] * y[off + k]
+    lever = fric[p, F_LEVER]
+    return -lever * sx, -lever * sy
+
+
+@helper_njit
+def add_plate_moment(n, p, fx, fy, fric, out):
+    """Modal forces (h/2) F_t . grad phi of the friction force (fx, fy) (N, on the ball) of
+    plate pair p, reversed on the plate's top surface (modal table row), added to the modes'
+    accelerations in ``out`` (unit modal mass)."""
+    nm = (fric.shape[1] - F_GRAD) // 2
+    off = 6 * n + nm
+    lever = fric[p, F_MOMENT]
+    for k in range(nm):
+        out[off + k] += lever * (fx * fric[p, F_GRAD + k] + fy * fric[p, F_GRAD + nm + k])
+
+
+@helper_njit
 def add_friction(y, n, off, p, i, j, fn, nx, ny, nz, mass, radius, fric, out):
     """Add pair p's friction force and torques to dy/dt ``out`` (accelerations, angular
-    accelerations with the moment of inertia 2/5 m r^2)."""
+    accelerations with the moment of inertia 2/5 m r^2; on the modal plate the modes'
+    accelerations from the force's moment, ``add_plate_moment``)."""
     r = pair_friction(y, n, off, i, j, p, nx, ny, nz, fn, fric)
     vi, wi = 3 * n + 3 * i, off + 3 * i
     inertia = 0.4 * mass[i] * radius[i] * radius[i]
@@ -106,3 +145,5 @@ def add_friction(y, n, off, p, i, j, fn, nx, ny, nz, mass, radius, fric, out):
         out[wj] += r[6] / inertia
         out[wj + 1] += r[7] / inertia
         out[wj + 2] += r[8] / inertia
+    elif fric.shape[1] > F_GRAD and fric[p, F_MOMENT] != 0.0:
+        add_plate_moment(n, p, r[0], r[1], fric, out)

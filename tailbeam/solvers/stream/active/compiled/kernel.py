@@ -49,6 +49,9 @@ from tailbeam.solvers.numerics.jit import helper_njit
 from tailbeam.solvers.stream.active.compiled.events import detect, prepare
 from tailbeam.solvers.stream.active.compiled.fresh import MAX_FRESH, found_again, hand_back, mark
 from tailbeam.solvers.stream.active.compiled.friction import (
+    F_GRAD,
+    F_LEVER,
+    F_MOMENT,
     IMP_N,
     IMP_T,
     IMP_WORK,
@@ -133,7 +136,7 @@ def _accept(t, h, ynew, dense, nodes, pts, vinv, model, pstate, rows, iout, ws):
             pen[p] = max(pen[p], interpolant_max(vals, vinv, wc, wc2)[1])
         if pj[p] >= 0:
             continue
-        _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj)
+        _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj, tmp)
 
 
 @helper_njit
@@ -145,7 +148,8 @@ def _impulses(h, p, dense, pts, vinv, model, forces, imp, tmp):
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     coef, y0 = dense[2], dense[3]
     n = mass.shape[0]
-    off = spin_offset(n, omega.shape[0])
+    nm = omega.shape[0]
+    off = spin_offset(n, nm)
     i, j = pi[p], pj[p]
     for q in range(pts.shape[0]):
         s = pts[q]
@@ -155,6 +159,9 @@ def _impulses(h, p, dense, pts, vinv, model, forces, imp, tmp):
             for k in range(3):
                 for base in (3 * b, 3 * n + 3 * b, off + 3 * b):
                     tmp[base + k] = dense_component(coef, y0, s, base + k)
+        if j < 0 and fric.shape[1] > F_GRAD and fric[p, F_LEVER] != 0.0:
+            for k in range(6 * n + nm, 6 * n + 2 * nm):  # the modal rates (surface velocity)
+                tmp[k] = dense_component(coef, y0, s, k)
         _, _, nx, ny, nz = pair_state(tmp, n, i, j, rsum[p], phi, p)
         r = pair_friction(tmp, n, off, i, j, p, nx, ny, nz, forces[q], fric)
         wq = cc_weight(vinv, q) * h
@@ -198,9 +205,11 @@ def _pair_values(p, dense, pts, model, pstate, forces, deltas):
 
 
 @helper_njit
-def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj):
+def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj, tmp):
     """Force rows of plate pair p at ``nodes`` interior points of the step and its end (the
-    plate deflection under the ball from its projected dense output, ``project``)."""
+    plate deflection under the ball from its projected dense output, ``project``); with
+    friction's moment on the modal plate also its friction force's rows (``_friction_rows``;
+    the state there from the dense output into ``tmp``)."""
     mass, radius, g, half, pi, pj, law, rsum, e_settle, alive, omega, zeta, phi, fdead, fric = model
     ramp, clamped = pstate[1], pstate[2]
     n = mass.shape[0]
@@ -214,9 +223,44 @@ def _node_rows(t, h, p, nodes, coef, y, ynew, model, pstate, rows, iout, proj):
         f = plate_force(p, z, vz, dense_projected(wq, s), dense_projected(wv, s),
                         dense_projected(wa, s), kappa, law, rsum, ramp, clamped)[0]  # fmt: skip
         _write_row(rows, iout, t + s * h, p, f)
+        if _moment_rows(fric, p):
+            _dense_plate_pair(coef, y, s, n, i, omega.shape[0], tmp)
+            _friction_rows(rows, iout, t + s * h, tmp, n, p, i, f, model)
     f = pair_force(ynew, n, p, pi, pj, law, rsum, ramp, clamped, phi, mass, g, omega, zeta,
                    fdead)[0]  # fmt: skip
     _write_row(rows, iout, t + h, p, f)
+    if _moment_rows(fric, p):
+        _friction_rows(rows, iout, t + h, ynew, n, p, i, f, model)
+
+
+@helper_njit
+def _moment_rows(fric, p):
+    """Whether plate pair p's friction force drives the modal plate (rows for the sensors)."""
+    return fric.shape[1] > F_GRAD and fric[p, F_MOMENT] != 0.0
+
+
+@helper_njit
+def _dense_plate_pair(coef, y, s, n, i, nm, out):
+    """Ball i's position, velocity and angular velocity and the modal rates at fraction s of
+    the step (dense output) into ``out`` (a state-sized array)."""
+    off = spin_offset(n, nm)
+    for k in range(3):
+        for base in (3 * i, 3 * n + 3 * i, off + 3 * i):
+            out[base + k] = dense_component(coef, y, s, base + k)
+    for k in range(6 * n + nm, 6 * n + 2 * nm):
+        out[k] = dense_component(coef, y, s, k)
+
+
+@helper_njit
+def _friction_rows(rows, iout, t, y, n, p, i, f, model):
+    """Rows (t, p + P, F_x) and (t, p + 2 P, F_y) of plate pair p's friction force on its
+    ball (N) at state y and normal force f (N): P the number of pairs (the plate takes
+    -F_t on its top surface, ``forces.PlateForces``)."""
+    fric, omega, pi = model[14], model[10], model[4]
+    npairs = pi.shape[0]
+    r = pair_friction(y, n, spin_offset(n, omega.shape[0]), i, -1, p, 0.0, 0.0, 1.0, f, fric)
+    _write_row(rows, iout, t, p + npairs, r[0])
+    _write_row(rows, iout, t, p + 2 * npairs, r[1])
 
 
 @helper_njit
@@ -303,13 +347,14 @@ def _settle(y, model, pstate, count, plate_pair):
 @helper_njit
 def _rows_needed(model, pstate, nodes):
     """Force rows one more step (and its events) may write: (nodes + 1) per touching plate
-    pair, plus a start and an end row."""
-    pi, pj = model[4], model[5]
+    pair (three times that with friction's rows, ``_friction_rows``), plus a start and an
+    end row."""
+    pi, pj, fric = model[4], model[5], model[14]
     touching = pstate[0]
     m = 0
     for p in range(pi.shape[0]):
         if touching[p] and pj[p] < 0:
-            m += 1
+            m += 3 if _moment_rows(fric, p) else 1
     return (nodes + 1) * m + 2
 
 
