@@ -110,7 +110,7 @@ def build_basis(scene: Scene, band: dict | None = None, *, use_cache: bool = Tru
     settings = scene.modal or ModalPlateSettings()
     band = band or choose_band(scene, settings)
     if settings.mesh is not None:
-        return structure_basis(scene, settings, band)
+        return structure_basis(scene, settings, band, use_cache=use_cache)
     try:
         return compute_modes(
             scene.plate, settings.boundary, theory=settings.theory, fmax_hz=band["fmax_hz"],
@@ -120,18 +120,21 @@ def build_basis(scene: Scene, band: dict | None = None, *, use_cache: bool = Tru
         raise err.renamed(SCENE_FIELDS) from None
 
 
-def structure_basis(scene: Scene, settings: ModalPlateSettings, band: dict):
+def structure_basis(scene: Scene, settings: ModalPlateSettings, band: dict, *,
+                    use_cache: bool = True):  # fmt: skip
     """The modes below the band of the scene's structure from ``plate.mesh``
-    (``tailbeam.plate.solid``; the model is the one the scene reader built). Not cached:
-    every run solves them again."""
+    (``tailbeam.plate.solid``; the model is the one the scene reader built), from the disk
+    cache when they were solved before."""
     model = held_structure(settings.mesh, settings.impact_face, settings.supports,
                            scene.plate.material)  # fmt: skip
-    note(
-        f"structure from plate.mesh: {model.n_dofs} DOFs, {model.element}; its modes to "
-        f"{band['fmax_hz'] / 1e3:g} kHz are solved now (not cached)"
+    basis = structure_modes(model, fmax_hz=band["fmax_hz"], use_cache=use_cache)
+    how = {"hit": "read from the cache", "miss": "solved and cached"}.get(
+        basis.info["cache"], f"solved (cache {basis.info['cache']})"
     )
-    basis = structure_modes(model, fmax_hz=band["fmax_hz"])
-    basis.info["cache"] = "off"
+    note(
+        f"structure from plate.mesh: {model.n_dofs} DOFs, {model.element}; its "
+        f"{basis.n_modes} modes to {band['fmax_hz'] / 1e3:g} kHz {how}"
+    )
     return basis
 
 
