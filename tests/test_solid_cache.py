@@ -150,3 +150,76 @@ def test_static_compliances_read_back(mesh, tmp_path, monkeypatch):
     assert np.array_equal(again.static_compliance_at(pts[::-1], 0.004), direct[::-1])
     with pytest.raises(AssertionError, match="solved again"):  # a new radius is solved
         again.static_compliance_at(pts, 0.005)
+
+
+SCENE = f"""duration = 0.001
+[plate]
+model = "modal"
+mesh = "plate.msh"
+impact_face = "top"
+fmax = {FMAX}
+[[plate.supports]]
+group = "left"
+kind = "pinned"
+axis = [0.0, 1.0, 0.0]
+[[plate.supports]]
+group = "right"
+kind = "spring"
+stiffness = 2.0e6
+[[balls]]
+name = "b"
+material = "sandstone"
+radius = 0.02
+position = [0.0, 0.0, 0.0205]
+velocity = [0.0, 0.0, -1.0]
+"""
+
+
+def test_modes_vtu_of_a_structure_reads_back(mesh, tmp_path, capsys):
+    """`tailbeam modes SCENE --vtu`: modes.vtu read back with meshio holds the volume mesh
+    and each mode's displacement, equal to shape_at's surface reading at the surface nodes
+    along x, y and z; the frequencies (field data and frequencies.csv) are the basis'."""
+    import csv
+
+    import meshio
+
+    from tailbeam.cli.main import main
+
+    shutil.copy(mesh, tmp_path / "plate.msh")
+    (tmp_path / "beam.toml").write_text(SCENE)
+    out = tmp_path / "modes"
+    assert main(["modes", str(tmp_path / "beam.toml"), "--vtu", "--out", str(out)]) == 0
+    model = assemble_structure(mesh, "top", SUPPORTS)
+    basis = structure_modes(model, fmax_hz=FMAX, use_cache=False)
+    back = meshio.read(out / "modes.vtu")
+    assert back.cells[0].type == "hexahedron" and len(back.cells[0].data) == 18
+    assert np.array_equal(back.points, model.vmesh.mesh.p.T)
+    assert np.allclose(back.field_data["frequencies_hz"], basis.frequencies_hz, rtol=1e-12)
+    names = sorted(back.point_data)
+    assert len(names) == basis.n_modes and names[0].startswith("mode_001_")
+    shapes = np.stack([back.point_data[n] for n in names], axis=2)  # (p, 3, n)
+    nodes = np.flatnonzero(np.isclose(back.points[:, 2], -0.02))[::3]  # on the bottom face
+    for axis in range(3):
+        dirs = np.tile(np.eye(3)[axis], (len(nodes), 1))
+        expected = basis.shape_at(back.points[nodes], dirs)
+        scale = np.abs(expected).max()
+        assert np.allclose(shapes[nodes, axis, :], expected, rtol=0, atol=1e-9 * scale)
+    with open(out / "frequencies.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert np.allclose([float(r["frequency_hz"]) for r in rows], basis.frequencies_hz, rtol=1e-9)
+    capsys.readouterr()
+    assert main(["modes", str(tmp_path / "beam.toml"), "--out", str(out)]) == 0
+    assert "cache hit" in capsys.readouterr().out
+
+
+def test_modes_scene_refuses_plate_options(mesh, tmp_path, capsys):
+    from tailbeam.cli.main import main
+
+    shutil.copy(mesh, tmp_path / "plate.msh")
+    (tmp_path / "beam.toml").write_text(SCENE)
+    out = tmp_path / "modes"
+    for extra, name in ((["--bc", "CCCC"], "--bc"), (["--png"], "--png")):
+        assert main(["modes", str(tmp_path / "beam.toml"), "--out", str(out), *extra]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and name in err[0]
+        assert not out.exists()

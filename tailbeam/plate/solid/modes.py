@@ -44,6 +44,19 @@ class StructureModalBasis(ModalBasis):
         op = self.model.surface_operator(points, directions, field_name)
         return np.asarray(op @ self.mode_vectors)[:, : self.n_modes]
 
+    def nodal_displacements(self, nodes=None) -> np.ndarray:
+        """(p, 3, n) each mode's displacement vector (1/sqrt(kg)) at the mesh's corner nodes
+        ``nodes`` (indices of ``model.vmesh.mesh.p`` columns; default all of them)."""
+        probe = self.model.probe()
+        if nodes is None:
+            nodes = np.arange(self.model.vmesh.mesh.p.shape[1])
+        scalar_dofs = probe.scalar.nodal_dofs[0, nodes]  # the value at each corner node
+        out = np.empty((len(nodes), 3, self.n_modes))
+        for c, idx in enumerate(probe.indices):
+            rows = self.model.transform[idx[scalar_dofs]]
+            out[:, c, :] = np.asarray(rows @ self.mode_vectors)[:, : self.n_modes]
+        return out
+
     def vtk_structure(self):
         """(points (p, 3) m, meshio cell blocks, shapes (p, 3, n) 1/sqrt(kg)): the outer
         surface (its boundary faces on the mesh's corner nodes) and each mode's displacement
@@ -54,14 +67,8 @@ class StructureModalBasis(ModalBasis):
         if kind == "quad":
             corners = cyclic_corners(mesh.p, corners).T
         nodes, local = np.unique(corners, return_inverse=True)
-        probe = self.model.probe()
-        scalar_dofs = probe.scalar.nodal_dofs[0, nodes]  # the value at each corner node
-        shapes = np.empty((len(nodes), 3, self.n_modes))
-        for c, idx in enumerate(probe.indices):
-            rows = self.model.transform[idx[scalar_dofs]]
-            shapes[:, c, :] = np.asarray(rows @ self.mode_vectors)[:, : self.n_modes]
         cells = [(kind, local.reshape(corners.shape).T.astype(np.int64))]
-        return mesh.p[:, nodes].T.copy(), cells, shapes
+        return mesh.p[:, nodes].T.copy(), cells, self.nodal_displacements(nodes)
 
 
 def _shift(model: StructureModel, fmax_hz: float | None) -> float:
