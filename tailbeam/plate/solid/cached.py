@@ -16,6 +16,7 @@ for them (``StaticCompliances``).
 """
 
 import dataclasses
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -94,25 +95,21 @@ def store_basis(path: Path, key: str, freqs, phi, info: dict) -> None:
 class StaticCompliances:
     """``model.static_compliance`` through a per-structure file of the values already
     computed (points and disc radii rounded to ``ROUND`` decimals of a metre); new values
-    are computed by the model (its factorisation, made on first need) and the file rewritten
-    atomically with them. ``cache_dir`` None: no file, the model's values."""
+    are computed by the model (its factorisation, made on first need). The file is rewritten
+    atomically, merged with what another run wrote, after the first new value and then
+    whenever the new values reach the number saved (a stream's thousands of contact points
+    cost O(n) writes), and at exit. ``cache_dir`` None: no file, the model's values."""
 
     def __init__(self, model: StructureModel, cache_dir=None):
         self.model = model
-        self.path = None
         self.values = {}
+        self.unsaved = [0]  # new values not yet in the file (a list: the exit hook reads it)
+        self.path = self.key = None
         if cache_dir is not None:
             self.key = static_key(model)
             self.path = disk.entry_path(cache_dir, STATIC_PREFIX, self.key)
-            self.values = self._read()
-
-    def _read(self) -> dict:
-        status, found = disk.read_entry(self.path, self.key)
-        if status == "damaged":
-            note(f"static compliance cache: {self.path} is damaged ({found}); recomputing it")
-        if status != "hit":
-            return {}
-        return {tuple(k): float(v) for k, v in zip(found["points"], found["values"], strict=True)}
+            self.values.update(_read_static(self.path, self.key))
+            weakref.finalize(self, _flush, self.path, self.key, self.values, self.unsaved)
 
     def __call__(self, points, contact_radius: float = 0.0) -> np.ndarray:
         """(p,) mean z-deflection (m/N) over the disc under 1 N spread over it."""
@@ -123,20 +120,35 @@ class StaticCompliances:
         if todo:
             fresh = self.model.static_compliance(pts[todo], contact_radius)
             self.values.update({keys[i]: float(v) for i, v in zip(todo, fresh, strict=True)})
-            self._write()
+            self.unsaved[0] += len(todo)
+            if self.path is not None and self.unsaved[0] >= max(1, len(self.values) // 2):
+                _flush(self.path, self.key, self.values, self.unsaved)
         return np.array([self.values[k] for k in keys])
 
-    def _write(self) -> None:
-        if self.path is None:
-            return
-        known = dict(self._read()) if self.path.is_file() else {}
-        self.values = {**known, **self.values}  # another run's values kept
-        arrays = {"points": np.array(list(self.values), dtype=float).reshape(-1, 3),
-                  "values": np.array(list(self.values.values()), dtype=float)}  # fmt: skip
-        try:
-            disk.write_entry(self.path, self.key, arrays, {"what": "static compliance m/N"})
-        except OSError:
-            self.path = None  # an unwritable cache: values stay in memory
+
+def _read_static(path: Path, key: str) -> dict:
+    status, found = disk.read_entry(path, key)
+    if status == "damaged":
+        note(f"static compliance cache: {path} is damaged ({found}); recomputing it")
+    if status != "hit":
+        return {}
+    return {tuple(k): float(v) for k, v in zip(found["points"], found["values"], strict=True)}
+
+
+def _flush(path: Path, key: str, values: dict, unsaved: list) -> None:
+    """Merge ``values`` (updated in place) with the file's and write them when ``unsaved[0]``
+    new ones are not in it yet (unwritable: kept in memory only)."""
+    if not unsaved[0]:
+        return
+    unsaved[0] = 0
+    for k, v in _read_static(path, key).items():
+        values.setdefault(k, v)
+    arrays = {"points": np.array(list(values), dtype=float).reshape(-1, 3),
+              "values": np.array(list(values.values()), dtype=float)}  # fmt: skip
+    try:
+        disk.write_entry(path, key, arrays, {"what": "static compliance m/N"})
+    except OSError:
+        pass  # an unwritable cache: the values stay in memory for this run
 
 
 __all__ = ["StaticCompliances", "basis_key", "basis_path", "load_basis", "static_key",

@@ -65,7 +65,6 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
     band = band or (stream_band(scene) if stream else choose_band(scene, settings))
     fmax = band["fmax_hz"]
     if settings.mesh is not None:
-        check_structure_solver(settings, stream)
         return _structure_plan(scene, settings, band)
     try:
         dofs, modes, cached, divisions, theory = _size(scene, settings, fmax)
@@ -91,17 +90,6 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
                      _alternative(scene, settings, band, stream, parts), dofs, ritz)  # fmt: skip
 
 
-def check_structure_solver(settings, stream: bool) -> None:
-    """A structure from plate.mesh runs on the single-ball solver only: InputError naming
-    plate.mesh on the stream solvers' set-up (``stream``)."""
-    if settings.mesh is not None and stream:
-        raise InputError(
-            "plate.mesh",
-            "a structure from a mesh runs on the single-ball solver only; the stream solvers "
-            "(--solver stream, stream-reference) do not take plate.mesh yet",
-        )
-
-
 def _structure_plan(scene, settings, band: dict) -> BasisPlan:
     """A structure from plate.mesh: its DOFs are known (the scene reader built it), the cost
     of its modes is not estimated (no model of a solid's mode count and factor fill yet);
@@ -111,7 +99,7 @@ def _structure_plan(scene, settings, band: dict) -> BasisPlan:
     model = held_structure(settings.mesh, settings.impact_face, settings.supports,
                            scene.plate.material)  # fmt: skip
     driver = (f"structure from plate.mesh, {model.n_dofs} DOFs, band {fmax / 1e3:g} kHz: "
-              "cost of the structure's modes not estimated, not cached")  # fmt: skip
+              "cost of the structure's modes not estimated")  # fmt: skip
     modes = _estimated_count(scene.plate, parse_boundary("CCCC"), "mindlin", fmax)
     parts = (Part("eigen-solve", 0.0, 0.0, driver, estimated=False),
              setup_part(model.n_dofs, 0))  # fmt: skip

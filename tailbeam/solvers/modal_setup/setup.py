@@ -17,11 +17,10 @@ from tailbeam.plate.basis import ModalBasis, modal_damping
 from tailbeam.plate.contact_tail import ContactTail
 from tailbeam.plate.fe.modes import compute_modes
 from tailbeam.plate.solid.held import held_structure
-from tailbeam.plate.solid.modes import structure_modes
+from tailbeam.plate.solid.modes import StructureModalBasis, structure_modes
 from tailbeam.progress import note
 from tailbeam.scene import ModalPlateSettings, Scene
 from tailbeam.solvers.modal_setup.band import check_stream_band, choose_band, stream_band
-from tailbeam.solvers.modal_setup.plan import check_structure_solver
 from tailbeam.solvers.modal_setup.ritz_prepass import apply_tail, check_tail_scene, describe_tail
 
 SCENE_FIELDS = {"fmax_hz": "plate.fmax", "divisions": "plate.mesh_divisions"}
@@ -85,7 +84,6 @@ def stream_setup(scene: Scene) -> ModalSetup:
     """The modal plate of a stream scene: the sensors' band (checked against the stream's
     shortest contacts), its basis and, where they apply, the contact tails."""
     settings = scene.modal or ModalPlateSettings()
-    check_structure_solver(settings, stream=True)
     check_tail_scene(scene)  # before any work
     band = stream_band(scene)
     if band["tail_band_hz"] is None and settings.tail != "quasi-static":
@@ -160,8 +158,11 @@ def contact_tail(scene: Scene, band: dict, basis: ModalBasis) -> ContactTail:
 def tail_basis(scene: Scene, band: dict, basis: ModalBasis) -> ModalBasis:
     """The basis of a stream's contact tails: to band["tail_band_hz"] on the band basis' own
     FE mesh (its modes below the band are the band's; the mesh the wider band alone would
-    choose is ~5x larger and takes minutes), or a closed form."""
+    choose is ~5x larger and takes minutes), or a closed form, or (a structure from
+    plate.mesh) the same structure's modes to that band (cached)."""
     wide_hz = band["tail_band_hz"]
+    if isinstance(basis, StructureModalBasis):  # the same structure to the tails' band
+        return structure_modes(basis.model, fmax_hz=wide_hz)
     if "divisions" not in basis.info:  # a closed form
         return build_basis(scene, {**band, "fmax_hz": wide_hz})
     return compute_modes(scene.plate, basis.boundary, theory=basis.info["theory"],
