@@ -5,7 +5,9 @@ and the element convergence study on the flat plate.
 
 Beam: meshes/tail_beam.msh (``--mesh``), pinned at ``hinge``, the jack a spring of
 ``--jack`` N/m on ``jack``, every mode below ``--fmax`` (cold: assembly, Sylvester count,
-shift-invert Lanczos), peak resident memory of the process (getrusage).
+shift-invert Lanczos), peak resident memory of the process (getrusage); then the same basis
+read back from the disk cache (a fresh temporary folder): its load time, file size and
+whether it equals the solved one bit for bit.
 
 ``--refine SIZE``: the example beam against the same beam meshed at SIZE m (meshes/tail_beam.py,
 gmsh), every mode below ``--refine-fmax`` (2 kHz): the rib-stiffened box against a finer
@@ -14,14 +16,18 @@ solution.
 ``--impact FMAX``: one sandstone ball on the beam through the coupled solver (the structure's
 basis to FMAX Hz, passed unchanged), over a rib and between ribs.
 
+``--load-only``: instead of solving, a file of the 5 kHz basis' shape (81 640 x 477 random
+vectors) written under the beam's real cache key, read back three times by
+``structure_modes`` (wall and CPU time of each load; the load path alone, in a minute).
+
 ``--study``: the flat 0.6 x 0.6 x 0.01 m free steel plate as a volume mesh of serendipity
 hexahedra (one and two layers through the thickness), triquadratic hexahedra and quadratic
 tetrahedra over in-plane divisions, against the converged Reissner-Mindlin plate (Lagrange P4,
 32 divisions) and with the Mindlin-Kirchhoff difference beside it: the first 30 frequencies'
 largest relative difference. Needs gmsh only for the beam mesh when it is absent.
 
-Writes DIR/bench_structure_modes.csv (beam), DIR/element_study.csv, DIR/refinement.csv,
-DIR/impacts.csv and DIR/table.md.
+Writes DIR/bench_structure_modes.csv (beam), DIR/cache_load.csv (--load-only),
+DIR/element_study.csv, DIR/refinement.csv, DIR/impacts.csv and DIR/table.md.
 Single-threaded BLAS (OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1) for reproducible timings.
 """
 
@@ -60,15 +66,50 @@ def beam(mesh: Path, fmax: float, jack: float) -> dict:
     supports = [Support("pinned", group="hinge"), Support("spring", group="jack", stiffness=jack)]
     model = assemble_structure(mesh, "top", supports)
     t1 = time.perf_counter()
-    basis = structure_modes(model, fmax_hz=fmax)
-    t2 = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="tailbeam-bench-cache-") as folder:
+        basis = structure_modes(model, fmax_hz=fmax, cache_dir=folder)  # cold: solved, saved
+        t2 = time.perf_counter()
+        cpu_cold = cpu_s() - c0
+        again = structure_modes(model, fmax_hz=fmax, cache_dir=folder)  # read back
+        t3 = time.perf_counter()
+        size = Path(basis.info["cache_file"]).stat().st_size
+    same = np.array_equal(again.mode_vectors, basis.mode_vectors) and np.array_equal(
+        again.frequencies_hz, basis.frequencies_hz
+    )
     f = basis.frequencies_hz
     return {"mesh": str(mesh), "dofs": model.n_dofs, "cells": basis.info["n_cells"],
             "element": model.element, "fmax_hz": fmax, "modes": basis.n_modes,
             "first_hz": f[0], "last_hz": f[-1], "assembly_s": t1 - t0,
-            "eigensolve_s": t2 - t1, "total_s": t2 - t0, "cpu_s": cpu_s() - c0,
+            "eigensolve_s": t2 - t1, "total_s": t2 - t0, "cpu_s": cpu_cold,
+            "cached_load_s": t3 - t2, "cache_file_mb": size / 1e6,
+            "cached_equal": bool(same and again.info["cache"] == "hit"),
             "load_average_1min": os.getloadavg()[0], "peak_gb": peak_gb(),
             "first_10_hz": " ".join(f"{v:.1f}" for v in f[:10])}  # fmt: skip
+
+
+def load_only(mesh: Path, jack: float, n_modes: int = 477) -> list:
+    """Load time of a cached basis of the example beam's 5 kHz shape (module docstring)."""
+    from tailbeam.plate.solid import Support, assemble_structure, cached, structure_modes
+
+    supports = [Support("pinned", group="hinge"), Support("spring", group="jack", stiffness=jack)]
+    model = assemble_structure(mesh, "top", supports)
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="tailbeam-bench-cache-") as folder:
+        key = cached.basis_key(model, 5000.0, None)
+        path = cached.basis_path(folder, key)
+        rng = np.random.default_rng(0)
+        phi = rng.standard_normal((model.n_dofs, n_modes))
+        freqs = np.sort(rng.uniform(30.0, 5000.0, n_modes))
+        cached.store_basis(path, key, freqs, phi, {"theory": "solid", "impact_face": "top"})
+        for i in range(3):
+            w, c = time.perf_counter(), cpu_s()
+            basis = structure_modes(model, fmax_hz=5000.0, cache_dir=folder)
+            rows.append({"load": i + 1, "cache": basis.info["cache"],
+                         "wall_s": time.perf_counter() - w, "cpu_s": cpu_s() - c,
+                         "file_mb": path.stat().st_size / 1e6,
+                         "equal": bool(np.array_equal(basis.mode_vectors, phi)),
+                         "load_average_1min": os.getloadavg()[0]})  # fmt: skip
+    return rows
 
 
 def refinement(mesh: Path, fine_size: float, fmax: float, jack: float) -> list:
@@ -195,6 +236,7 @@ def main(argv=None):
     parser.add_argument("--jack", type=float, default=2.0e8, help="jack stiffness, N/m")
     parser.add_argument("--study", action="store_true", help="also the element study")
     parser.add_argument("--skip-beam", action="store_true")
+    parser.add_argument("--load-only", action="store_true", help="only the cache's load time")
     parser.add_argument("--rungs", type=int, nargs="+", default=[12, 16, 24, 32])
     parser.add_argument(
         "--refine",
@@ -212,7 +254,12 @@ def main(argv=None):
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     parts = []
-    if not args.skip_beam:
+    if args.load_only:
+        rows = load_only(args.mesh, args.jack)
+        print(rows, flush=True)
+        write_csv(args.out / "cache_load.csv", rows)
+        parts.append("## Cached basis load\n\n" + table(rows))
+    elif not args.skip_beam:
         row = beam(args.mesh, args.fmax, args.jack)
         print(row, flush=True)
         write_csv(args.out / "bench_structure_modes.csv", [row])

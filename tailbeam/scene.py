@@ -244,13 +244,6 @@ class Scene:
         if self.modal is not None and self.modal.tail_modes is None:  # the solver's default
             k = self.modal.tail_modes_for(self.needs_stream_solver)
             object.__setattr__(self, "modal", replace(self.modal, tail_modes=k))
-        if self.modal is not None and self.modal.mesh is not None and self.needs_stream_solver:
-            raise InputError(
-                "plate.mesh",
-                "a structure from a mesh runs single balls only (the single-ball solver); "
-                "the stream solver (streams, an inclined plate or balls that may touch) does "
-                "not take plate.mesh yet",
-            )
 
     def _check_labels(self) -> None:
         labels = tuple(self.labels) or tuple(default_label(b) for b in self.balls)

@@ -20,6 +20,7 @@ from tailbeam.plate.solid import cost as C
 from tailbeam.plate.solid import modes as solid_modes
 from tailbeam.plate.solid.factor import factorize
 from tailbeam.simulation import choose_solver
+from tailbeam.solvers.modal_setup.plan import plan_bases
 from tailbeam.solvers.run_cost import estimate_run
 
 SIDE, THICK = 0.6, 0.01
@@ -131,3 +132,19 @@ def test_a_structure_scenes_cost_line_estimates_its_eigen_solve(tmp_path, monkey
     eigen = cost.part("eigen-solve")
     assert eigen.estimated and eigen.time_s > 0 and "factor entries" in eigen.driver
     assert "not estimated" not in cost.describe()
+
+
+def test_a_cached_structure_is_costed_as_its_reading(tmp_path, monkeypatch):
+    """Once the structure's basis is in the cache the eigen-solve part is the file's reading,
+    with the cached basis' own mode count (its vectors' columns)."""
+    plate_mesh(str(tmp_path / "plate.msh"), divisions=12)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("TAILBEAM_CACHE_DIR", str(tmp_path / "cache"))
+    scene = loads_scene(STRUCTURE_SCENE)
+    solver = choose_solver(scene, "auto")
+    assert not estimate_run(scene, solver).part("eigen-solve").cached
+    model = assemble_structure("plate.msh", "top", (Support(kind="clamped", group="sides"),))
+    basis = solid_modes.structure_modes(model, fmax_hz=3000.0)
+    eigen = estimate_run(scene, solver).part("eigen-solve")
+    assert eigen.cached and "cached" in eigen.driver
+    assert plan_bases(scene, stream=False).n_modes == len(basis.frequencies_hz)

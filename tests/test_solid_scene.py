@@ -135,7 +135,6 @@ def small(tmp_path_factory):
 
 SUPPORT = '[[plate.supports]]\ngroup = "sides"\nkind = "clamped"\n'
 SENSOR_3D = '[[sensors]]\nname = "back"\nposition = [0.0, 0.0, -0.005]\n'  # inside: off the surface
-SECOND_BALL = BALL.replace('"b"', '"c"').replace("0.05, 0.0", "0.06, 0.0")  # may touch b
 BAD = {  # case: (text replaced, by, field named), "" replaced: appended
     "unreadable": ("plate.msh", "junk.msh", "plate.mesh"),
     "missing": ("plate.msh", "missing.msh", "plate.mesh"),
@@ -147,7 +146,6 @@ BAD = {  # case: (text replaced, by, field named), "" replaced: appended
     "rigid": ('model = "modal"\n', "", "plate.mesh"),
     "no mesh": ('mesh = "meshes/plate.msh"\n', "", "plate.impact_face"),
     "3D sensor": ("", SENSOR_3D, "sensors[1].position"),
-    "stream solver": ("", SECOND_BALL, "plate.mesh"),
 }
 
 
@@ -157,21 +155,3 @@ def test_bad_structure_keys_are_one_line(small, tmp_path, capsys, case):
     text = STRUCTURE + BALL
     text = text + new if not old else text.replace(old, new)
     _refused(tmp_path, capsys, text.replace("meshes/", f"{small / 'meshes'}/"), field)
-
-
-def test_stream_solver_on_a_structure_is_refused(small, tmp_path, capsys):
-    text = (STRUCTURE + BALL).replace("meshes/", f"{small / 'meshes'}/")
-    (tmp_path / "s.toml").write_text(text)
-    argv = [
-        "simulate",
-        str(tmp_path / "s.toml"),
-        "--solver",
-        "stream",
-        "-q",
-        "--out",
-        str(tmp_path / "o"),
-    ]
-    assert main(argv) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "plate.mesh" in err[0] and "stream" in err[0], err
-    assert not (tmp_path / "o").exists()

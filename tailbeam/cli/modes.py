@@ -7,6 +7,12 @@ reference only) into --out (atomically); modes.vtu (ParaView) with --vtu and mod
 --png (figures and VTU cost more than a cached solve: only what is asked for is written).
 Bad input names the option (--fmax, --count, --divisions, ...), also when the band is too
 costly to compute (tailbeam.plate.fe.cost, estimated before anything is assembled).
+
+With a scene file (SCENE) the plate is the scene's: its flat plate (size, material,
+boundary, theory, mesh divisions, plate.fmax as the band unless --fmax/--count), or its
+structure from plate.mesh (``tailbeam.plate.solid``: impact face, supports, material), whose
+modes.vtu is the volume mesh with each mode's displacement vector
+(``tailbeam.plate.solid.export``). The options that describe the plate are then refused.
 """
 
 from tailbeam.errors import InputError
@@ -16,6 +22,16 @@ from tailbeam.physics.materials import BUILTIN_MATERIALS, get_material
 from tailbeam.plate.export import PNG_MODES
 
 THEORIES = ("auto", "kirchhoff", "mindlin")
+# the plate options a scene file replaces, and their defaults without one
+PLATE_OPTIONS = {
+    "bc": "SSSS",
+    "theory": "auto",
+    "divisions": None,
+    "mesh": None,
+    "accuracy": 1e-3,
+    "material": "carbon_steel",
+    "size": (0.6, 0.6, 0.01),
+}
 
 # library field names -> the options a user typed (tailbeam.cli renames InputError fields)
 CLI_FIELDS = {
@@ -34,11 +50,19 @@ CLI_FIELDS = {
 
 def add_arguments(parser):
     parser.add_argument(
+        "scene",
+        nargs="?",
+        default=None,
+        metavar="SCENE",
+        help="a scene file (TOML): its plate, or its structure from plate.mesh, instead of "
+        "the plate options",
+    )
+    parser.add_argument(
         "--bc",
-        default="SSSS",
+        default=None,
         metavar="CODE",
         help="boundary code: C, S or F for the edges left, bottom, right, top "
-        "(x=-a/2, y=-b/2, x=+a/2, y=+b/2)",
+        "(x=-a/2, y=-b/2, x=+a/2, y=+b/2) (default: SSSS)",
     )
     band = parser.add_mutually_exclusive_group()
     band.add_argument(
@@ -57,9 +81,9 @@ def add_arguments(parser):
     )
     parser.add_argument(
         "--theory",
-        default="auto",
+        default=None,
         choices=THEORIES,
-        help="plate theory; auto chooses from --accuracy and the plate",
+        help="plate theory; auto chooses from --accuracy and the plate (default: auto)",
     )
     parser.add_argument(
         "--divisions",
@@ -76,21 +100,24 @@ def add_arguments(parser):
         "with its edges named left, bottom, right, top (default: a generated mesh)",
     )
     parser.add_argument(
-        "--accuracy", type=float, default=1e-3, help="target relative frequency error"
+        "--accuracy",
+        type=float,
+        default=None,
+        help="target relative frequency error (default: 0.001)",
     )
     parser.add_argument(
         "--material",
-        default="carbon_steel",
+        default=None,
         choices=tuple(BUILTIN_MATERIALS),
-        help="built-in material",
+        help="built-in material (default: carbon_steel)",
     )
     parser.add_argument(
         "--size",
         type=float,
         nargs=3,
-        default=(0.6, 0.6, 0.01),
+        default=None,
         metavar=("A", "B", "H"),
-        help="plate size a, b and thickness h in m",
+        help="plate size a, b and thickness h in m (default: 0.6 0.6 0.01)",
     )
     parser.add_argument("--no-cache", action="store_true", help="neither read nor write cache")
     parser.add_argument("--vtu", action="store_true", help="also write modes.vtu (ParaView)")
@@ -124,11 +151,20 @@ def reference_frequencies(basis):
 
 
 def run(args) -> int:
-    from tailbeam.plate import compute_modes
-
     check_output_dir(args.out)
     if args.count is not None and args.count < 1:
         raise InputError("count", f"must be >= 1, got {args.count}")
+    if args.scene is not None:
+        return _run_scene(args)
+    for name, default in PLATE_OPTIONS.items():
+        if getattr(args, name) is None:
+            setattr(args, name, default)
+    return _run_options(args)
+
+
+def _run_options(args) -> int:
+    from tailbeam.plate import compute_modes
+
     material = get_material(args.material, field="material")
     a, b, h = args.size
     plate = Plate(material=material, size_x=a, size_y=b, thickness=h)
@@ -143,11 +179,16 @@ def run(args) -> int:
         accuracy=args.accuracy,
         use_cache=not args.no_cache,
     )
+    return _report(args, basis, f"{basis.boundary} plate {a} x {b} x {h} m, {material.name}")
+
+
+def _report(args, basis, what: str) -> int:
+    """Print the flat plate's table (with references) and write its files."""
     refs = reference_frequencies(basis)
     info = basis.info
     print(
-        f"{basis.boundary} plate {a} x {b} x {h} m, {material.name}: {basis.n_modes} modes, "
-        f"{info['theory']} ({info['element']}), {info['n_dofs']} DOFs, cache {info['cache']}"
+        f"{what}: {basis.n_modes} modes, {info['theory']} ({info['element']}), "
+        f"{info['n_dofs']} DOFs, cache {info['cache']}"
     )
     print(f"  why: {info['reason']}")
     head = f"{'mode':>5} {'f [Hz]':>12}"
@@ -192,4 +233,74 @@ def _write(args, basis, refs) -> None:
             export.write_png(tmp / "modes.png", basis)
             shown = min(PNG_MODES, basis.n_modes)
             names.append(f"modes.png (the first {shown} of {basis.n_modes} modes)")
+    print(f"wrote {', '.join(names)} to {args.out}")
+
+
+def _run_scene(args) -> int:
+    """``tailbeam modes SCENE``: the scene's flat plate or structure (module docstring)."""
+    from tailbeam.io.scene_file import load_scene
+    from tailbeam.plate import compute_modes
+
+    given = [name for name in PLATE_OPTIONS if getattr(args, name) is not None]
+    if given:
+        raise InputError(f"--{given[0]}", "not with a scene file: the scene sets the plate")
+    scene = load_scene(args.scene)
+    settings = scene.modal
+    if settings is None:
+        raise InputError("plate.model", "must be 'modal' for tailbeam modes (a rigid plate "
+                         "has no modes)")  # fmt: skip
+    fmax = args.fmax if args.fmax is not None or args.count is not None else settings.fmax_hz
+    if settings.mesh is not None:
+        return _structure(args, scene, fmax)
+    basis = compute_modes(scene.plate, settings.boundary, theory=settings.theory, fmax_hz=fmax,
+                          count=args.count, divisions=settings.mesh_divisions,
+                          use_cache=not args.no_cache)  # fmt: skip
+    p = scene.plate
+    what = f"{basis.boundary} plate {p.size_x} x {p.size_y} x {p.thickness} m, {p.material.name}"
+    return _report(args, basis, what)
+
+
+def _structure(args, scene, fmax) -> int:
+    """The modes of the scene's structure from plate.mesh: a table, frequencies.csv and (with
+    --vtu) the volume mesh's modes.vtu."""
+    from tailbeam.plate.solid import structure_modes
+    from tailbeam.plate.solid.held import held_structure
+
+    settings = scene.modal
+    if fmax is None and args.count is None:
+        raise InputError("--fmax", "a structure needs a band: give --fmax or --count, or "
+                         "plate.fmax in the scene")  # fmt: skip
+    if args.png:
+        raise InputError("--png", "draws a flat plate's modes; for a structure use --vtu")
+    model = held_structure(settings.mesh, settings.impact_face, settings.supports,
+                           scene.plate.material)  # fmt: skip
+    basis = structure_modes(model, fmax_hz=fmax, count=args.count, use_cache=not args.no_cache)
+    info = basis.info
+    print(
+        f"structure {settings.mesh} ({basis.boundary}), {scene.plate.material.name}: "
+        f"{basis.n_modes} modes, {info['theory']} ({info['element']}), {info['n_dofs']} DOFs, "
+        f"cache {info['cache']}"
+    )
+    print(f"{'mode':>5} {'f [Hz]':>12}")
+    for i, f in enumerate(basis.frequencies_hz):
+        print(f"{i + 1:5d} {f:12.3f}")
+    _write_structure(args, basis, settings.mesh)
+    return 0
+
+
+def _write_structure(args, basis, mesh) -> None:
+    """frequencies.csv and, with --vtu, modes.vtu of a structure into --out (atomically)."""
+    from tailbeam.plate import export
+    from tailbeam.plate.solid.export import write_modes_vtu
+
+    names = ["frequencies.csv"]
+    with atomic_output_dir(args.out, command="tailbeam modes") as tmp:
+        path = export.write_frequencies_csv(tmp / "frequencies.csv", basis.frequencies_hz,
+                                            basis.theory)  # fmt: skip
+        face = basis.info["impact_face"]
+        describe(path, units={"frequency_hz": "Hz"}, boundary=basis.boundary,
+                 theory=basis.theory, mesh=str(mesh), impact_face=face)  # fmt: skip
+        if args.vtu:
+            write_modes_vtu(tmp / "modes.vtu", basis)
+            names.append("modes.vtu")
     print(f"wrote {', '.join(names)} to {args.out}")

@@ -1,11 +1,16 @@
 """On-disk cache of computed modal bases (one .npz per basis).
 
-The file name is a SHA-256 over everything that determines the result: the code and cache
-format version, the mesh arrays (points, triangles, named edges), the material (density,
-Young's modulus, Poisson ratio), the plate size and thickness, the theory and element, the
-shear coefficient, the boundary code and the band (fmax, count). Any change gives another
-key, so a stale basis is never reused; the key is also stored in the file and checked on
-load. Default folder: $TAILBEAM_CACHE_DIR, else ~/.cache/tailbeam.
+The flat plate's bases (``cache_key``, ``save``, ``load``): the file name is a SHA-256 over
+everything that determines the result: the code and cache format version, the mesh arrays
+(points, triangles, named edges), the material (density, Young's modulus, Poisson ratio),
+the plate size and thickness, the theory and element, the shear coefficient, the boundary
+code and the band (fmax, count). Any change gives another key, so a stale basis is never
+reused; the key is also stored in the file and checked on load.
+
+A structure's bases (``tailbeam.plate.solid.cached``) use the same folder and writer with
+their own key (``entry_key``: a dict of what determines the basis and the mesh arrays) and
+``read_entry``/``write_entry``, which tell a missing entry from a damaged one.
+Default folder: $TAILBEAM_CACHE_DIR, else ~/.cache/tailbeam.
 """
 
 import hashlib
@@ -74,7 +79,6 @@ def save(
     info: dict,
 ) -> None:
     """Write atomically (temp file + rename) so a crash never leaves a truncated entry."""
-    path.parent.mkdir(parents=True, exist_ok=True)
     arrays = {
         "key": np.array(key),
         "frequencies_hz": np.asarray(frequencies_hz, dtype=float),
@@ -87,6 +91,12 @@ def save(
     }
     for name, facets in (mesh.boundaries or {}).items():
         arrays[f"boundary:{name}"] = np.asarray(facets, dtype=np.int64)
+    _write_npz(path, arrays)
+
+
+def _write_npz(path: Path, arrays: dict) -> None:
+    """Write ``arrays`` to ``path`` atomically (temp file in the same folder + rename)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".modes-", suffix=".npz", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -122,6 +132,46 @@ def load(path: Path, key: str):
             )
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
         return None  # a damaged entry is recomputed (and overwritten), never trusted
+
+
+def entry_key(meta: dict, arrays) -> str:
+    """Hex SHA-256 of ``meta`` (JSON, with the cache format and package version added) and
+    the bytes, dtypes and shapes of ``arrays`` (an iterable of (name, ndarray), in order)."""
+    h = hashlib.sha256()
+    h.update(json.dumps({**meta, "format": CACHE_FORMAT, "version": __version__},
+                        sort_keys=True, default=_jsonable).encode())  # fmt: skip
+    for name, arr in arrays:
+        arr = np.ascontiguousarray(arr)
+        h.update(f"{name}:{arr.dtype.str}:{arr.shape}".encode())
+        h.update(arr.tobytes())
+    return h.hexdigest()
+
+
+def entry_path(cache_dir, prefix: str, key: str) -> Path:
+    """The cache file of entry ``key``: ``<cache_dir>/<prefix>-<key[:32]>.npz``."""
+    return Path(cache_dir) / f"{prefix}-{key[:32]}.npz"
+
+
+def write_entry(path: Path, key: str, arrays: dict, info: dict) -> None:
+    """Save ``arrays`` (name -> ndarray) with ``key`` and ``info`` (JSON), atomically."""
+    out = {**arrays, "key": np.array(key), "info": np.array(json.dumps(info, default=_jsonable))}
+    _write_npz(path, out)
+
+
+def read_entry(path: Path, key: str):
+    """("hit", arrays dict with "info" parsed), ("missing", None) for no file or another
+    key's file, or ("damaged", reason) for a file that cannot be read (never trusted)."""
+    if not path.is_file():
+        return "missing", None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if str(data["key"]) != key:
+                return "missing", None
+            out = {name: data[name] for name in data.files if name not in ("key", "info")}
+            out["info"] = json.loads(str(data["info"]))
+            return "hit", out
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as err:
+        return "damaged", f"{type(err).__name__}: {err}".splitlines()[0]
 
 
 def _jsonable(value):

@@ -65,8 +65,6 @@ def warm_basis(scene_toml: str) -> str:
         scene = loads_scene(scene_toml)
         if scene.plate_model != "modal":
             return "rigid plate: no basis"
-        if scene.modal.mesh is not None:
-            return "structure from plate.mesh: its modes are not cached, each case solves them"
         band = stream_band(scene) if scene.needs_stream_solver else None
         with quiet():  # a worker's notes and bars would interleave on the user's terminal
             basis = build_basis(scene, band)

@@ -17,7 +17,9 @@ from threadpoolctl import threadpool_limits
 
 from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.plate.basis import ModalBasis
+from tailbeam.plate.cache import default_cache_dir
 from tailbeam.plate.fe.sparse_solve import count_eigenvalues_below, lowest_modes
+from tailbeam.plate.solid import cached
 from tailbeam.plate.solid.factor import factorize
 from tailbeam.plate.solid.model import StructureModel
 from tailbeam.plate.solid.surface import cyclic_corners
@@ -42,6 +44,19 @@ class StructureModalBasis(ModalBasis):
         op = self.model.surface_operator(points, directions, field_name)
         return np.asarray(op @ self.mode_vectors)[:, : self.n_modes]
 
+    def nodal_displacements(self, nodes=None) -> np.ndarray:
+        """(p, 3, n) each mode's displacement vector (1/sqrt(kg)) at the mesh's corner nodes
+        ``nodes`` (indices of ``model.vmesh.mesh.p`` columns; default all of them)."""
+        probe = self.model.probe()
+        if nodes is None:
+            nodes = np.arange(self.model.vmesh.mesh.p.shape[1])
+        scalar_dofs = probe.scalar.nodal_dofs[0, nodes]  # the value at each corner node
+        out = np.empty((len(nodes), 3, self.n_modes))
+        for c, idx in enumerate(probe.indices):
+            rows = self.model.transform[idx[scalar_dofs]]
+            out[:, c, :] = np.asarray(rows @ self.mode_vectors)[:, : self.n_modes]
+        return out
+
     def vtk_structure(self):
         """(points (p, 3) m, meshio cell blocks, shapes (p, 3, n) 1/sqrt(kg)): the outer
         surface (its boundary faces on the mesh's corner nodes) and each mode's displacement
@@ -52,14 +67,8 @@ class StructureModalBasis(ModalBasis):
         if kind == "quad":
             corners = cyclic_corners(mesh.p, corners).T
         nodes, local = np.unique(corners, return_inverse=True)
-        probe = self.model.probe()
-        scalar_dofs = probe.scalar.nodal_dofs[0, nodes]  # the value at each corner node
-        shapes = np.empty((len(nodes), 3, self.n_modes))
-        for c, idx in enumerate(probe.indices):
-            rows = self.model.transform[idx[scalar_dofs]]
-            shapes[:, c, :] = np.asarray(rows @ self.mode_vectors)[:, : self.n_modes]
         cells = [(kind, local.reshape(corners.shape).T.astype(np.int64))]
-        return mesh.p[:, nodes].T.copy(), cells, shapes
+        return mesh.p[:, nodes].T.copy(), cells, self.nodal_displacements(nodes)
 
 
 def _shift(model: StructureModel, fmax_hz: float | None) -> float:
@@ -101,18 +110,42 @@ def _signed(phi: np.ndarray) -> np.ndarray:
     return phi * np.where(signs == 0, 1.0, signs)
 
 
-def structure_modes(model: StructureModel, *, fmax_hz=None, count=None, blas_threads=1):
+def structure_modes(model: StructureModel, *, fmax_hz=None, count=None, blas_threads=1,
+                    cache_dir=None, use_cache: bool = True):  # fmt: skip
     """The elastic modes of ``model`` below ``fmax_hz`` (Hz) and/or the first ``count``, as a
     StructureModalBasis (theory 'solid'); the static compliance of the held structure backs
-    the residual flexibility."""
+    the residual flexibility.
+
+    The basis and the static compliances are cached on disk (``tailbeam.plate.solid.cached``;
+    ``cache_dir`` default $TAILBEAM_CACHE_DIR or ~/.cache/tailbeam); ``use_cache=False``
+    neither reads nor writes. ``info["cache"]`` says "hit", "miss" or "off".
+    """
     if fmax_hz is None and count is None:
         raise InputError("fmax_hz", "give fmax_hz or count")
     if fmax_hz is not None:
         fmax_hz = require_positive("fmax_hz", fmax_hz)
-    t0 = time.perf_counter()
-    with threadpool_limits(limits=blas_threads), task("eigen-solve", unit="solves") as bar:
-        freqs, phi = solve_band(model, fmax_hz, count, on_solve=bar.update)
-    info = _describe(model, fmax_hz, count, time.perf_counter() - t0)
+    folder = (cache_dir or default_cache_dir()) if use_cache else None
+    path = key = hit = None
+    if use_cache:
+        key = cached.basis_key(model, fmax_hz, count)
+        path = cached.basis_path(folder, key)
+        hit = cached.load_basis(path, key, model.n_dofs)
+    if hit is not None:
+        freqs, phi, info = hit
+        info.update(cache="hit", cache_file=str(path))
+    else:
+        t0 = time.perf_counter()
+        with threadpool_limits(limits=blas_threads), task("eigen-solve", unit="solves") as bar:
+            freqs, phi = solve_band(model, fmax_hz, count, on_solve=bar.update)
+        info = _describe(model, fmax_hz, count, time.perf_counter() - t0)
+        info.update(cache="miss" if use_cache else "off", cache_file=str(path) if path else None)
+        if use_cache:
+            cached.store_basis(path, key, freqs, phi, info)
+    return _wrap(model, freqs, phi, info, folder)
+
+
+def _wrap(model: StructureModel, freqs, phi, info: dict, cache_dir) -> StructureModalBasis:
+    """The StructureModalBasis of reduced mode vectors ``phi`` (n_dofs, k)."""
 
     def deflection_at(points):
         return np.asarray(model.face_operator(points) @ phi)
@@ -120,11 +153,11 @@ def structure_modes(model: StructureModel, *, fmax_hz=None, count=None, blas_thr
     held = model.rigid_modes == 0
     return StructureModalBasis(
         plate=model.plate,
-        frequencies_hz=freqs,
+        frequencies_hz=np.asarray(freqs, dtype=float),
         deflection_at=deflection_at,
         theory=THEORY,
         boundary=_boundary(model),
-        static_compliance_at=model.static_compliance if held else None,
+        static_compliance_at=cached.StaticCompliances(model, cache_dir) if held else None,
         static_deflection_at=model.static_deflection if held else None,
         info=info,
         mode_vectors=phi,

@@ -284,6 +284,9 @@ def _stream_tail(settings, fmax: float, two_way: bool) -> dict:
     wide = min(TAIL_BAND_FACTOR * fmax, TAIL_MAX_HZ)
     if settings.tail == "quasi-static":
         why = "plate.tail"
+    elif settings.tail == "auto" and settings.mesh is not None:
+        why = ("a structure from plate.mesh: its contact tails need its modes to "
+               f"{TAIL_BAND_FACTOR:g}x the band, solved only with plate.tail = 'ritz'")  # fmt: skip
     elif not (two_way and settings.residual_flexibility):
         why = "one-way coupling" if not two_way else "residual flexibility off"
     elif wide < 1.5 * fmax:

@@ -22,6 +22,7 @@ from tailbeam.plate.fe.mindlin import DEFAULT_DEGREE
 from tailbeam.plate.fe.model import resolve_mesh
 from tailbeam.plate.fe.modes import _estimated_count
 from tailbeam.plate.fe.resolution import resolve
+from tailbeam.plate.solid import cached as cached_structure
 from tailbeam.plate.solid.cost import structure_cost
 from tailbeam.plate.solid.held import held_structure
 from tailbeam.scene import ModalPlateSettings
@@ -66,7 +67,6 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
     band = band or (stream_band(scene) if stream else choose_band(scene, settings))
     fmax = band["fmax_hz"]
     if settings.mesh is not None:
-        check_structure_solver(settings, stream)
         return _structure_plan(scene, settings, band)
     try:
         dofs, modes, cached, divisions, theory = _size(scene, settings, fmax)
@@ -92,17 +92,6 @@ def plan_bases(scene, stream: bool, band: dict | None = None) -> BasisPlan:
                      _alternative(scene, settings, band, stream, parts), dofs, ritz)  # fmt: skip
 
 
-def check_structure_solver(settings, stream: bool) -> None:
-    """A structure from plate.mesh runs on the single-ball solver only: InputError naming
-    plate.mesh on the stream solvers' set-up (``stream``)."""
-    if settings.mesh is not None and stream:
-        raise InputError(
-            "plate.mesh",
-            "a structure from a mesh runs on the single-ball solver only; the stream solvers "
-            "(--solver stream, stream-reference) do not take plate.mesh yet",
-        )
-
-
 def _structure_plan(scene, settings, band: dict) -> BasisPlan:
     """A structure from plate.mesh: its DOFs and matrices are known (the scene reader built
     it); its eigen-solve is estimated from them (``tailbeam.plate.solid.cost``), and the
@@ -111,12 +100,22 @@ def _structure_plan(scene, settings, band: dict) -> BasisPlan:
     model = held_structure(settings.mesh, settings.impact_face, settings.supports,
                            scene.plate.material)  # fmt: skip
     cost = structure_cost(model, fmax)
+    path = cached_structure.basis_path(None, cached_structure.basis_key(model, fmax, None))
+    try:
+        size = float(path.stat().st_size)
+    except OSError:
+        size = None
     driver = (f"structure from plate.mesh, band {fmax / 1e3:g} kHz from "
-              f"{_why(band, False)}: {cost.describe()}, not cached")  # fmt: skip
+              f"{_why(band, False)}: {cost.describe()}")  # fmt: skip
+    modes = cost.n_modes
+    if size is None:
+        eigen = Part("eigen-solve", cost.time_s, cost.memory_bytes, driver + ", not cached")
+    else:  # the file holds the (n_dofs, modes) float64 vectors
+        modes = max(1, int(size // (8 * model.n_dofs)))
+        eigen = eigen_part("eigen-solve", model.n_dofs, modes, size, driver + ", cached")
     static = Part("set-up", cost.factorise_s, cost.memory_bytes,
                   "the static compliance: one factorisation")  # fmt: skip
-    parts = (Part("eigen-solve", cost.time_s, cost.memory_bytes, driver), static)
-    return BasisPlan(parts, cost.n_modes, fmax, settings.coupling == "two-way", 0, "",
+    return BasisPlan((eigen, static), modes, fmax, settings.coupling == "two-way", 0, "",
                      model.n_dofs, 0)  # fmt: skip
 
 

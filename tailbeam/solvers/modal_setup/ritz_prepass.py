@@ -228,6 +228,13 @@ def check_tail_scene(scene) -> None:
     settings = scene.modal
     if settings is None or settings.tail == "quasi-static":
         return
+    if settings.tail == "ritz" and settings.mesh is not None and not scene.needs_stream_solver:
+        raise InputError(
+            "plate.tail",
+            "'ritz' is not built on a structure from plate.mesh for single balls; use "
+            "'quasi-static' or 'auto' (its residual flexibility is the structure's static "
+            "compliance)",
+        )
     if scene.needs_stream_solver:
         if settings.tail_modes == "auto":
             raise InputError(
@@ -237,12 +244,6 @@ def check_tail_scene(scene) -> None:
                 f"(default {STREAM_TAIL_MODES})",
             )
         return
-    if settings.tail == "ritz" and settings.mesh is not None:
-        raise InputError(
-            "plate.tail",
-            "'ritz' is not built on a structure from plate.mesh yet; use 'quasi-static' or "
-            "'auto' (its residual flexibility is the structure's static compliance)",
-        )
     tail_modes = settings.tail_modes_for(stream=False)
     if settings.tail == "ritz" and tail_modes != "auto":
         _check_work(tail_modes, len(_unique(first_contacts(scene, "kirchhoff"))))

@@ -17,11 +17,10 @@ from tailbeam.plate.basis import ModalBasis, modal_damping
 from tailbeam.plate.contact_tail import ContactTail
 from tailbeam.plate.fe.modes import compute_modes
 from tailbeam.plate.solid.held import held_structure
-from tailbeam.plate.solid.modes import structure_modes
+from tailbeam.plate.solid.modes import StructureModalBasis, structure_modes
 from tailbeam.progress import note
 from tailbeam.scene import ModalPlateSettings, Scene
 from tailbeam.solvers.modal_setup.band import check_stream_band, choose_band, stream_band
-from tailbeam.solvers.modal_setup.plan import check_structure_solver
 from tailbeam.solvers.modal_setup.ritz_prepass import apply_tail, check_tail_scene, describe_tail
 
 SCENE_FIELDS = {"fmax_hz": "plate.fmax", "divisions": "plate.mesh_divisions"}
@@ -85,7 +84,6 @@ def stream_setup(scene: Scene) -> ModalSetup:
     """The modal plate of a stream scene: the sensors' band (checked against the stream's
     shortest contacts), its basis and, where they apply, the contact tails."""
     settings = scene.modal or ModalPlateSettings()
-    check_structure_solver(settings, stream=True)
     check_tail_scene(scene)  # before any work
     band = stream_band(scene)
     if band["tail_band_hz"] is None and settings.tail != "quasi-static":
@@ -110,7 +108,7 @@ def build_basis(scene: Scene, band: dict | None = None, *, use_cache: bool = Tru
     settings = scene.modal or ModalPlateSettings()
     band = band or choose_band(scene, settings)
     if settings.mesh is not None:
-        return structure_basis(scene, settings, band)
+        return structure_basis(scene, settings, band, use_cache=use_cache)
     try:
         return compute_modes(
             scene.plate, settings.boundary, theory=settings.theory, fmax_hz=band["fmax_hz"],
@@ -120,18 +118,21 @@ def build_basis(scene: Scene, band: dict | None = None, *, use_cache: bool = Tru
         raise err.renamed(SCENE_FIELDS) from None
 
 
-def structure_basis(scene: Scene, settings: ModalPlateSettings, band: dict):
+def structure_basis(scene: Scene, settings: ModalPlateSettings, band: dict, *,
+                    use_cache: bool = True):  # fmt: skip
     """The modes below the band of the scene's structure from ``plate.mesh``
-    (``tailbeam.plate.solid``; the model is the one the scene reader built). Not cached:
-    every run solves them again."""
+    (``tailbeam.plate.solid``; the model is the one the scene reader built), from the disk
+    cache when they were solved before."""
     model = held_structure(settings.mesh, settings.impact_face, settings.supports,
                            scene.plate.material)  # fmt: skip
-    note(
-        f"structure from plate.mesh: {model.n_dofs} DOFs, {model.element}; its modes to "
-        f"{band['fmax_hz'] / 1e3:g} kHz are solved now (not cached)"
+    basis = structure_modes(model, fmax_hz=band["fmax_hz"], use_cache=use_cache)
+    how = {"hit": "read from the cache", "miss": "solved and cached"}.get(
+        basis.info["cache"], f"solved (cache {basis.info['cache']})"
     )
-    basis = structure_modes(model, fmax_hz=band["fmax_hz"])
-    basis.info["cache"] = "off"
+    note(
+        f"structure from plate.mesh: {model.n_dofs} DOFs, {model.element}; its "
+        f"{basis.n_modes} modes to {band['fmax_hz'] / 1e3:g} kHz {how}"
+    )
     return basis
 
 
@@ -157,8 +158,11 @@ def contact_tail(scene: Scene, band: dict, basis: ModalBasis) -> ContactTail:
 def tail_basis(scene: Scene, band: dict, basis: ModalBasis) -> ModalBasis:
     """The basis of a stream's contact tails: to band["tail_band_hz"] on the band basis' own
     FE mesh (its modes below the band are the band's; the mesh the wider band alone would
-    choose is ~5x larger and takes minutes), or a closed form."""
+    choose is ~5x larger and takes minutes), or a closed form, or (a structure from
+    plate.mesh) the same structure's modes to that band (cached)."""
     wide_hz = band["tail_band_hz"]
+    if isinstance(basis, StructureModalBasis):  # the same structure to the tails' band
+        return structure_modes(basis.model, fmax_hz=wide_hz)
     if "divisions" not in basis.info:  # a closed form
         return build_basis(scene, {**band, "fmax_hz": wide_hz})
     return compute_modes(scene.plate, basis.boundary, theory=basis.info["theory"],
