@@ -488,8 +488,8 @@ def _check_sensor_place(field: str, spec: SensorSpec, plate: Plate, modal) -> No
         if off > FLAT_SURFACE_TOLERANCE * h:
             raise InputError(
                 f"{field}.position",
-                f"z = {z!r} m is {off:.3g} m off the flat plate's surface: give its top face "
-                f"z = 0 or its bottom face z = {-h!r} m",
+                f"z = {z!r} m is {off:.3g} m off the flat plate's surface: a point of its top "
+                f"face has z = 0, of its bottom face z = {-h!r} m",
             )
     if structure:
         return
