@@ -48,6 +48,7 @@ from tailbeam.solvers.stream.driver.loads import PlateLoads
 from tailbeam.solvers.stream.driver.membership import Membership
 from tailbeam.solvers.stream.driver.records import ContactRecords
 from tailbeam.solvers.stream.driver.set_events import SetEvents
+from tailbeam.solvers.stream.driver.sleep import Sleepers
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
@@ -124,6 +125,7 @@ def solve_stream(
     contacts=None,
     frames=(),
     friction=None,
+    sleep=True,
 ) -> StreamRun:
     """Simulate a stream of particles on an inclined plate.
 
@@ -158,8 +160,11 @@ def solve_stream(
     friction : FrictionModel, optional
         Friction and rolling resistance of every contact, the balls' rotation
         (``tailbeam.physics.friction``; rigid plate only). None: frictionless. With friction
-        no contact is put at rest (``rest_speed`` and SETTLE unused): a ball on the plate is
-        integrated for as long as it touches it.
+        no contact is put at rest by ``rest_speed`` or SETTLE: a ball on the plate is
+        integrated while it touches it, until its cluster is frozen (``sleep``).
+    sleep : bool
+        With friction: freeze resting clusters (``tailbeam.solvers.stream.driver.sleep``);
+        False integrates them for as long as they rest.
 
     Returns
     -------
@@ -182,7 +187,7 @@ def solve_stream(
         if plate is not None:
             plate.reset()
         sim = _Stream(particles, incline, duration, contacts, rtol, rest_speed, max_work, plate,
-                      friction, frames)  # fmt: skip
+                      friction, frames, sleep)  # fmt: skip
         try:
             run = _run(sim, duration, progress)
         except _Stuck as err:
@@ -249,10 +254,12 @@ class _Stream:
         The contacts' friction (rigid plate), or None.
     frames : sequence of float
         Frame times (s) at which every ball's state is recorded (``FrameRecorder``).
+    sleep : bool
+        With friction: freeze resting clusters (``Sleepers``).
     """
 
     def __init__(self, particles, incline, duration, contacts, rtol, rest_speed, max_events, plate,
-                 friction=None, frames=()):  # fmt: skip
+                 friction=None, frames=(), sleep=True):  # fmt: skip
         self.clock = clock = Clock(duration)
         self.balls = balls = Balls(particles, incline, contacts)
         self.plate, self.max_events, self.rounds = plate, max_events, 0
@@ -272,7 +279,11 @@ class _Stream:
         self.loads = PlateLoads(balls, act.forces)
         self.heap = Predictions(balls, clock, plate)
         parts = (balls, act, clock, self.heap)
-        self.membership = Membership(*parts, self.records, self.loads, self.ledger, plate)
+        sleepers = None
+        if sleep and friction is not None and plate is None:
+            sleepers = Sleepers(*parts, self.records, self.loads, self.ledger)
+        self.membership = Membership(*parts, self.records, self.loads, self.ledger, plate,
+                                     sleepers)  # fmt: skip
         shared = (*parts, self.membership, self.records, self.loads, self.ledger)
         self.set_events = SetEvents(*shared, rest_speed)
         self.heap_events = HeapEvents(*shared, plate)
@@ -362,6 +373,8 @@ class _Stream:
             if not b.in_set[i]:
                 loads.dead_load(int(i), duration)
         stats.update(act.stats())
+        if self.membership.sleepers is not None:
+            stats["asleep_final"] = self.membership.sleepers.asleep()
         stats["wall_s"] = wall
         stats["contacts"] = len(self.records.contacts)
         rec = self.records
