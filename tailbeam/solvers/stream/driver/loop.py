@@ -263,11 +263,13 @@ class _Stream:
         self.clock = clock = Clock(duration)
         self.balls = balls = Balls(particles, incline, contacts)
         self.plate, self.max_events, self.rounds = plate, max_events, 0
-        pairs = None
+        pairs, sleep = None, sleep and friction is not None and plate is None
+        hop_speed = rest_speed  # a plate contact ending slower than this holds the ball
         if friction is not None:
             pairs = FrictionPairs(friction, [p.material.name for p in particles], balls.radius,
                                   incline.plate.material.name)  # fmt: skip
-            rest_speed = 0.0  # (never at rest: the ball rolls, slides or is held by friction)
+            rest_speed = 0.0  # (no SETTLE, no slider: the ball rolls, slides or is held)
+            hop_speed = hop_speed if sleep else 0.0  # (held on the plate, integrated on)
 
         def settle_energy(i: int) -> float:
             return 0.5 * balls.mass[i] * rest_speed**2
@@ -280,12 +282,12 @@ class _Stream:
         self.heap = Predictions(balls, clock, plate)
         parts = (balls, act, clock, self.heap)
         sleepers = None
-        if sleep and friction is not None and plate is None:
+        if sleep:
             sleepers = Sleepers(*parts, self.records, self.loads, self.ledger)
         self.membership = Membership(*parts, self.records, self.loads, self.ledger, plate,
                                      sleepers)  # fmt: skip
         shared = (*parts, self.membership, self.records, self.loads, self.ledger)
-        self.set_events = SetEvents(*shared, rest_speed)
+        self.set_events = SetEvents(*shared, hop_speed)
         self.heap_events = HeapEvents(*shared, plate)
         self.frames = FrameRecorder(frames, balls, act)
 

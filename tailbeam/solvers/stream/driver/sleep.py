@@ -5,8 +5,10 @@ regularised law holds a ball by a creep below the stiction velocity v_s, so a re
 would be integrated (and creep) for as long as it rests. Instead, at every refresh of the
 active set (at least every ``membership.SET_HORIZON``):
 
-* a core ball is SLOW while its centre speed and its rim speed r |w| are both below the
-  smallest stiction velocity of its touching contacts;
+* a core ball is SLOW while its centre speed is below SLEEP_SPEED (the frictionless rest
+  speed: what is left then is mostly the normal oscillation of its contacts, lightly damped
+  at the static penetration) and its rim speed r |w| and the slip speed at each of its
+  touching contacts are below their smallest stiction velocity v_s;
 * a CLUSTER is a connected set of core balls through touching ball-ball contacts, at least
   one of them touching the plate; it is frozen when every ball of it has been slow for
   SLEEP_DWELL, and the rigid statics of its contacts admit equilibrium within the Coulomb
@@ -28,6 +30,7 @@ from tailbeam.solvers.stream.driver.balls import SLEEP
 from tailbeam.solvers.stream.driver.statics import in_equilibrium
 
 SLEEP_DWELL = 0.02  # s: a cluster is frozen after its balls have been slow this long
+SLEEP_SPEED = 0.01  # m/s: a slow ball's centre speed bound (its normal oscillation included)
 
 
 class Sleepers:
@@ -84,13 +87,24 @@ class Sleepers:
         return frozen
 
     def _is_slow(self, i: int) -> bool:
-        keys = self.act.touching_pairs(i)
+        """Ball i touches something, its centre moves slower than SLEEP_SPEED, and its rim
+        speed r |w| and the slip speed at each of its contacts are below the contacts'
+        smallest stiction velocity."""
+        act = self.act
+        keys = act.touching_pairs(i)
         if not keys:
             return False
-        v_s = min(self.act.friction.settings(k).stiction_velocity for k in keys)
-        _, v = self.act.state(i)
-        rim = self.balls.radius[i] * float(np.linalg.norm(self.act.spin(i)))
-        return float(np.linalg.norm(v)) < v_s and rim < v_s
+        v_s = min(act.friction.settings(k).stiction_velocity for k in keys)
+        x, v = act.state(i)
+        if float(np.linalg.norm(v)) >= SLEEP_SPEED:
+            return False
+        if self.balls.radius[i] * float(np.linalg.norm(act.spin(i))) >= v_s:
+            return False
+        for a, c in keys:
+            partner = () if c < 0 else (*act.state(c), act.spin(c))
+            if act.friction.slip((a, c), *act.state(a), act.spin(a), *partner) >= v_s:
+                return False
+        return True
 
     def _clusters(self, ready):
         """Connected clusters (sorted ball list, their touching keys) of touching balls, kept
