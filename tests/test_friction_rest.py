@@ -63,7 +63,8 @@ def ledger_gap(r) -> float:
 def test_statics_single_ball_is_the_closed_form():
     """A ball alone on the plate holds iff tan(theta) <= min(mu_s, mu_r R / (R - delta))."""
     x = [[0.0, 0.0, R]]
-    for theta, mu_r, holds in ((20, 0.5, True), (20, 0.3, False), (26, 0.5, True), (27, 0.5, False)):
+    cases = ((20, 0.5, True), (20, 0.3, False), (26, 0.5, True), (27, 0.5, False))
+    for theta, mu_r, holds in cases:
         t = math.radians(theta)
         g = G * np.array([math.sin(t), 0.0, -math.cos(t)])
         assert in_equilibrium(x, [0.1], g, [(0, -1, 1.0, 0.7, mu_r, R)]) is holds
