@@ -120,8 +120,10 @@ def test_rolling_ball_stops_at_the_closed_form_time_and_stays():
     # above v_s the deceleration is the closed form's
     fast = speed > 2 * V_S
     fit = np.polyfit(np.array(frames)[fast], speed[fast], 1)
-    assert -fit[0] == pytest.approx(a, rel=1e-3)
-    assert fit[1] / a == pytest.approx(t_stop, rel=1e-3)
+    # the deceleration to the lever arm's r - delta; the stop time to v_s / a: rolling is
+    # held by a slip below v_s, so the centre's speed is off the rim's by less than v_s
+    assert -fit[0] == pytest.approx(a, rel=1e-4)
+    assert fit[1] / a == pytest.approx(t_stop, abs=V_S / a)
     assert r.stats["sleeps"] == 1
     assert x[-1] == x[-2] and speed[-1] == 0.0  # frozen: exactly still
     assert abs(x[-1] - s_stop) <= CREEP_BOUND + V_S**2 / (2 * a) + 1e-4 * s_stop
