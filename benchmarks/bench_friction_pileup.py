@@ -10,7 +10,8 @@ v_s = 1e-3 m/s, v_d = 2e-3 m/s, damping 300 N s/m; the stream lasts n / 100 s an
 simulation 1 s longer (500 lumps: 5 s of stream, 6 s simulated).
 
 Rows, each case in its own process (timed inside it, after a warm-up that fills the numba
-cache): wall time, kernel steps, contacts, clusters frozen and woken, the fraction of the
+cache): wall and CPU time (the process's: the machine may be shared), kernel steps,
+contacts, clusters frozen and woken, the fraction of the
 lumps still on the plate that are asleep at the end, the energy ledger (released = final +
 left + removed at rest + friction; its residual, which must not be a gain), and the fitted
 exponent of wall time against the number of lumps. ``--compare`` adds the same short pile
@@ -71,16 +72,17 @@ def run_case(n: int, sleep: bool, extra: float = 1.0) -> dict:
     from tailbeam.solvers.stream.driver.loop import solve_stream
 
     scene = loads_scene(scene_text(n, extra))
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     run = solve_stream(scene.particles, scene.incline, scene.duration,
                        contacts=scene.contacts(), friction=scene.friction, sleep=sleep,
                        progress=False, max_work=10**9)  # fmt: skip
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     s = run.stats
     books = s["energy_final"] + s["energy_left"] + s["rest_energy_removed"] + s["energy_friction"]
     on_plate = len(run.final)
     return {
-        "lumps": n, "sleep": sleep, "wall_s": wall, "kernel_steps": int(s["kernel_steps"]),
+        "lumps": n, "sleep": sleep, "wall_s": wall, "cpu_s": cpu,
+        "kernel_steps": int(s["kernel_steps"]),
         "contacts": int(s["contacts"]), "sleeps": int(s.get("sleeps", 0)),
         "wakes": int(s.get("wakes", 0)), "sleep_refused": int(s.get("sleep_refused", 0)),
         "on_plate": on_plate, "asleep": int(s.get("asleep_final", 0)),
@@ -140,8 +142,9 @@ def main(argv=None) -> int:
               f"energy residual {row['energy_residual']:.3g} J", file=sys.stderr)  # fmt: skip
     result = {"rows": [{k: v for k, v in r.items() if k != "final"} for r in rows]}
     if len(rows) >= 2:
-        fit = np.polyfit(np.log([r["lumps"] for r in rows]), np.log([r["wall_s"] for r in rows]), 1)
-        result["cost_exponent"] = float(fit[0])
+        lumps = np.log([r["lumps"] for r in rows])
+        for key, col in (("cost_exponent", "wall_s"), ("cpu_exponent", "cpu_s")):
+            result[key] = float(np.polyfit(lumps, np.log([r[col] for r in rows]), 1)[0])
     if args.compare:
         on, off = _in_child(args.compare, True, 0.5), _in_child(args.compare, False, 0.5)
         result["compare"] = {"sleep": {k: v for k, v in on.items() if k != "final"},
@@ -157,17 +160,20 @@ def main(argv=None) -> int:
 
 def table(result: dict) -> str:
     """The rows as a markdown table."""
-    lines = ["| lumps | wall s | kernel steps | contacts | frozen / woken | asleep at end | "
-             "energy residual J (of released) |", "|---|---|---|---|---|---|---|"]  # fmt: skip
+    head = ("| lumps | wall s (CPU s) | kernel steps | contacts | frozen / woken | asleep at end "
+            "| energy residual J (of released) |")  # fmt: skip
+    lines = [head, "|---|---|---|---|---|---|---|"]
     for r in result["rows"]:
         lines.append(
-            f"| {r['lumps']} | {r['wall_s']:.1f} | {r['kernel_steps']} | {r['contacts']} | "
+            f"| {r['lumps']} | {r['wall_s']:.1f} ({r['cpu_s']:.1f}) | {r['kernel_steps']} | "
+            f"{r['contacts']} | "
             f"{r['sleeps']} / {r['wakes']} | {r['asleep']} of {r['on_plate']} "
             f"({r['at_rest_fraction']:.0%}) | {r['energy_residual']:.2e} "
             f"({r['energy_released']:.3g}) |"
         )  # fmt: skip
     if "cost_exponent" in result:
-        lines.append(f"\ncost exponent (wall time against lumps): {result['cost_exponent']:.2f}")
+        lines.append(f"\ncost exponent against lumps: wall time {result['cost_exponent']:.2f}, "
+                     f"CPU time {result['cpu_exponent']:.2f}")  # fmt: skip
     if "compare" in result:
         c = result["compare"]
         lines.append(
@@ -175,7 +181,8 @@ def table(result: dict) -> str:
             f"difference {c['largest_position_difference_m']:.3g} m (median "
             f"{c['median_position_difference_m']:.3g} m), energy difference "
             f"{c['energy_final_difference_J']:.3g} J; wall {c['sleep']['wall_s']:.1f} s vs "
-            f"{c['no_sleep']['wall_s']:.1f} s"
+            f"{c['no_sleep']['wall_s']:.1f} s, kernel steps {c['sleep']['kernel_steps']} vs "
+            f"{c['no_sleep']['kernel_steps']}"
         )  # fmt: skip
     return "\n".join(lines) + "\n"
 

@@ -6,7 +6,8 @@ struck ball never slept.
 
 Coal balls, r = 30 mm, v_s = 1e-3 m/s, v_d = 2e-3 m/s, rtol 1e-10, set down at their static
 penetration. The bound on a frozen ball's displacement is the creep it can make before it is
-frozen: below v_s for SLEEP_DWELL plus one refresh interval (SET_HORIZON).
+frozen: slip plus rolling, each below v_s, for SLEEP_DWELL plus one refresh interval
+(SET_HORIZON).
 """
 
 import math
@@ -29,7 +30,8 @@ G = STANDARD_GRAVITY
 R = 0.03
 COAL = get_material("coal")
 V_S = 1e-3
-CREEP_BOUND = V_S * (SLEEP_DWELL + SET_HORIZON)  # m: the most a ball creeps before freezing
+# m: the most a ball creeps before it is frozen: slip plus rolling, each below v_s
+CREEP_BOUND = 2.0 * V_S * (SLEEP_DWELL + SET_HORIZON)
 
 
 def static_pen(theta_deg: float) -> float:

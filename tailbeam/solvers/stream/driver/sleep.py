@@ -7,8 +7,10 @@ active set (at least every ``membership.SET_HORIZON``):
 
 * a core ball is SLOW while its centre speed is below SLEEP_SPEED (the frictionless rest
   speed: what is left then is mostly the normal oscillation of its contacts, lightly damped
-  at the static penetration) and its rim speed r |w| and the slip speed at each of its
-  touching contacts are below their smallest stiction velocity v_s;
+  at the static penetration, and the creep of the regularised law) and the slip and rolling
+  speeds at each of its touching contacts are below their smallest stiction velocity v_s
+  (a spin about a contact normal, free in the model, is not looked at and is dropped when
+  the ball is frozen);
 * a CLUSTER is a connected set of core balls through touching ball-ball contacts, at least
   one of them touching the plate; it is frozen when every ball of it has been slow for
   SLEEP_DWELL, and the rigid statics of its contacts admit equilibrium within the Coulomb
@@ -65,16 +67,21 @@ class Sleepers:
         """Freeze the clusters of ``core`` (set of ball numbers) ready to sleep; balls in
         ``excluded`` are not frozen now. Returns the balls frozen."""
         t = self.clock.t
+        touching = {}
+        for key in self.act.touching_keys():
+            for k in key:
+                if k >= 0:
+                    touching.setdefault(k, []).append(key)
         slow = set()
         for i in core:
-            if self._is_slow(i):
+            if self._is_slow(i, touching.get(i, [])):
                 slow.add(i)
                 self.slow_since.setdefault(i, t)
             else:
                 self.slow_since.pop(i, None)
         ready = {i for i in slow if t - self.slow_since[i] >= SLEEP_DWELL} - set(excluded)
         frozen = []
-        for comp, keys in self._clusters(ready):
+        for comp, keys in self._clusters(ready, touching):
             if not any(k[1] < 0 for k in keys):
                 continue
             if not self._holds(comp, keys):
@@ -86,29 +93,37 @@ class Sleepers:
             frozen.extend(comp)
         return frozen
 
-    def _is_slow(self, i: int) -> bool:
-        """Ball i touches something, its centre moves slower than SLEEP_SPEED, and its rim
-        speed r |w| and the slip speed at each of its contacts are below the contacts'
-        smallest stiction velocity."""
+    def _is_slow(self, i: int, keys) -> bool:
+        """Ball i touches something (``keys``), its centre moves slower than SLEEP_SPEED,
+        and the slip speed and the rolling speed (rolling radius x the relative angular
+        velocity's part in the contact plane) at each of its contacts are below the
+        contacts' smallest stiction velocity (twisting about a normal is free: not looked
+        at)."""
         act = self.act
-        keys = act.touching_pairs(i)
         if not keys:
             return False
         v_s = min(act.friction.settings(k).stiction_velocity for k in keys)
-        x, v = act.state(i)
+        _, v = act.state(i)
         if float(np.linalg.norm(v)) >= SLEEP_SPEED:
             return False
-        if self.balls.radius[i] * float(np.linalg.norm(act.spin(i))) >= v_s:
-            return False
         for a, c in keys:
-            partner = () if c < 0 else (*act.state(c), act.spin(c))
-            if act.friction.slip((a, c), *act.state(a), act.spin(a), *partner) >= v_s:
+            xa, va = act.state(a)
+            wa = act.spin(a)
+            if c < 0:
+                partner, n, w = (), np.array([0.0, 0.0, 1.0]), wa
+            else:
+                xc, vc = act.state(c)
+                wc = act.spin(c)
+                partner, n, w = (xc, vc, wc), (xa - xc) / np.linalg.norm(xa - xc), wa - wc
+            roll = act.friction.row((a, c))[6] * float(np.linalg.norm(w - (w @ n) * n))
+            if roll >= v_s or act.friction.slip((a, c), xa, va, wa, *partner) >= v_s:
                 return False
         return True
 
-    def _clusters(self, ready):
-        """Connected clusters (sorted ball list, their touching keys) of touching balls, kept
-        only when every ball of the cluster is in ``ready``."""
+    def _clusters(self, ready, touching):
+        """Connected clusters (sorted ball list, their touching keys) of touching balls
+        (``touching``: ball -> its touching keys), kept only when every ball of the cluster
+        is in ``ready``."""
         seen, out = set(), []
         for start in sorted(ready):
             if start in seen:
@@ -118,7 +133,7 @@ class Sleepers:
             while todo:
                 i = todo.pop()
                 comp.append(i)
-                for key in self.act.touching_pairs(i):
+                for key in touching.get(i, []):
                     keys.add(key)
                     for k in key:
                         if k >= 0 and k not in seen:
