@@ -17,6 +17,8 @@ penetration and it slides frictionlessly downhill in closed form (its normal osc
 below the rest energy, is dropped: the energy removed is counted in
 ``stats["rest_energy_removed"]``, ``energy``). A slider that something approaches joins the
 active set again, at its static state (an equilibrium of the full model, so nothing jumps).
+With friction (rigid plate) a resting cluster in static equilibrium within its Coulomb and
+rolling limits is frozen instead, and woken by a touch (``sleep``).
 
 Contacts are recorded as ``Impact`` (one per ball per contact; ``end`` an ``End``:
 separated, rest, left or duration; ``records``); the plate's contact forces are kept as
