@@ -295,6 +295,12 @@ class ActiveMembers:
             total += share * s.contact_energy(self.index[key])
         return total
 
+    def touching_keys(self) -> list:
+        """Keys of every pair in contact now."""
+        s = self._ready()
+        touching = s.contacts.touching
+        return [k for k, p in self.index.items() if touching[p]]
+
     def touching_pairs(self, i: int) -> list:
         """Keys of member i's pairs in contact now."""
         s = self._ready()

@@ -2,8 +2,9 @@
 
 A ball is PENDING (not released yet), FLY (free flight), SLIDE (resting quasi-statically on
 the frictionless plate: its centre at the static penetration, sliding downhill), ACTIVE (in
-the active set: integrated by the compiled kernel) or GONE (left over an edge). FLY and SLIDE
-balls move in closed form from a reference state (t0, x0, v0); ``version`` counts changes of
+the active set: integrated by the compiled kernel), GONE (left over an edge) or SLEEP (held
+at rest by friction, frozen: ``sleep``). FLY, SLIDE and SLEEP balls move in closed form (a
+sleeping ball stands still) from a reference state (t0, x0, v0); ``version`` counts changes of
 that motion, so predictions made for an older motion are recognised as stale.
 """
 
@@ -14,7 +15,8 @@ import numpy as np
 from tailbeam.physics.contacts import PLATE
 from tailbeam.solvers.numerics.flight import advance, band_time, edge_time, pair_time, plate_time
 
-PENDING, FLY, SLIDE, ACTIVE, GONE = range(5)
+PENDING, FLY, SLIDE, ACTIVE, GONE, SLEEP = range(6)
+_STILL = np.zeros(3)  # a sleeping ball's acceleration
 
 
 class Balls:
@@ -62,6 +64,8 @@ class Balls:
         return self.table.law(i, PLATE)
 
     def accel(self, i: int) -> np.ndarray:
+        if self.status[i] == SLEEP:
+            return _STILL
         return self.g_slide if self.status[i] == SLIDE else self.g
 
     def state(self, i: int, t: float):
@@ -72,6 +76,7 @@ class Balls:
         """Vectorised ``state`` for the balls ``idx`` (all FLY or SLIDE)."""
         idx = np.asarray(idx, dtype=np.int64)
         acc = np.where((self.status[idx] == SLIDE)[:, None], self.g_slide, self.g)
+        acc = np.where((self.status[idx] == SLEEP)[:, None], 0.0, acc)
         dt = (t - self.t0[idx])[:, None]
         return self.x0[idx] + self.v0[idx] * dt + 0.5 * acc * dt * dt, self.v0[idx] + acc * dt
 
@@ -87,8 +92,9 @@ class Balls:
         self.version[i] += 1
 
     def closed_form(self) -> np.ndarray:
-        """Indices of the balls moving in closed form (FLY or SLIDE)."""
-        return np.flatnonzero((self.status == FLY) | (self.status == SLIDE))
+        """Indices of the balls moving in closed form (FLY, SLIDE or SLEEP)."""
+        s = self.status
+        return np.flatnonzero((s == FLY) | (s == SLIDE) | (s == SLEEP))
 
     def resting(self, t: float):
         """(xy (p, 2) m, weights (p,) N) of the balls resting on the plate outside the
@@ -103,6 +109,7 @@ class Balls:
         """Bounds (m/s) on the speeds of closed-form balls ``idx`` over [t, t + horizon]."""
         _, v = self.states(idx, t)
         acc = np.where(self.status[idx] == SLIDE, abs(self.g_slide[0]), np.linalg.norm(self.g))
+        acc = np.where(self.status[idx] == SLEEP, 0.0, acc)
         return np.linalg.norm(v, axis=1) + acc * horizon
 
     def own_events(self, i: int, t: float, margin: float = 0.0) -> list:

@@ -27,6 +27,7 @@ class EnergyLedger:
 
     def __init__(self, balls, act, stats: dict):
         self.balls, self.act, self.stats = balls, act, stats
+        self.asleep = {}  # sleeping ball -> elastic energy (J) of its frozen contacts' share
         for key in ENTRIES:
             stats[key] = 0.0
         if act.friction is not None:
@@ -58,9 +59,11 @@ class EnergyLedger:
         return energy
 
     def elastic(self, i: int) -> float:
-        """Elastic energy (J) of the contacts of ball i: its plate contact (resting or not)
-        and half of each ball-ball contact (the other half is its partner's)."""
+        """Elastic energy (J) of the contacts of ball i: its plate contact (resting, asleep or
+        not) and half of each ball-ball contact (the other half is its partner's)."""
         if i not in self.act.members:
+            if i in self.asleep:
+                return self.asleep[i]
             if self.balls.status[i] != SLIDE:
                 return 0.0
             return float(elastic_energy(self.balls.static_pen[i], self.balls.plate_law(i)))

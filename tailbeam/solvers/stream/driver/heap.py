@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from tailbeam.solvers.stream.driver.balls import FLY
+from tailbeam.solvers.stream.driver.balls import FLY, SLEEP
 from tailbeam.solvers.stream.driver.broadphase import candidate_pairs
 
 # kinds of heap entries (the order breaks ties at equal times: releases first)
@@ -81,6 +81,9 @@ class Predictions:
         horizon = self.epoch_end - t
         x, _ = b.states(idx, t)
         pairs = candidate_pairs(x, b.radius[idx], b.speed_bounds(idx, t, horizon), horizon)
+        asleep = b.status[idx] == SLEEP
+        if len(pairs) and asleep.any():  # two sleeping balls stand still: never a new touch
+            pairs = pairs[~(asleep[pairs[:, 0]] & asleep[pairs[:, 1]])]
         for a, c in pairs:
             i, j = int(idx[a]), int(idx[c])
             if not (b.in_set[i] and b.in_set[j]):
@@ -100,6 +103,8 @@ class Predictions:
         horizon = self.epoch_end - t
         others = b.closed_form()
         others = others[(others != i) & ~(b.in_set[others] & b.in_set[i])]
+        if b.status[i] == SLEEP:  # (two sleeping balls stand still)
+            others = others[b.status[others] != SLEEP]
         if horizon <= 0.0 or not len(others):
             return
         xo, _ = b.states(others, t)

@@ -10,7 +10,7 @@ its seed and number alone), and only when none is free waits RELEASE_RETRY and t
 import numpy as np
 
 from tailbeam.results.records import EventKind
-from tailbeam.solvers.stream.driver.balls import ACTIVE, FLY, GONE, SLIDE
+from tailbeam.solvers.stream.driver.balls import ACTIVE, FLY, GONE, SLEEP, SLIDE
 from tailbeam.solvers.stream.driver.heap import EDGE, EPOCH, PAIR_TOUCH, PLATE_TOUCH, RELEASE
 
 RELEASE_RETRY = 1e-3  # s: a particle that would overlap a ball at its release waits this long
@@ -52,7 +52,7 @@ class HeapEvents:
         t, kind, _seq, i, j, _vi, _vj, edge = entry
         b = self.balls
         self.clock.stats["heap_events"] += 1
-        closed_form = (FLY, SLIDE)
+        closed_form = (FLY, SLIDE, SLEEP)
         if kind == RELEASE:
             self._release(i)
         elif kind == EPOCH:

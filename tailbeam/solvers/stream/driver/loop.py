@@ -17,6 +17,8 @@ penetration and it slides frictionlessly downhill in closed form (its normal osc
 below the rest energy, is dropped: the energy removed is counted in
 ``stats["rest_energy_removed"]``, ``energy``). A slider that something approaches joins the
 active set again, at its static state (an equilibrium of the full model, so nothing jumps).
+With friction (rigid plate) a resting cluster in static equilibrium within its Coulomb and
+rolling limits is frozen instead, and woken by a touch (``sleep``).
 
 Contacts are recorded as ``Impact`` (one per ball per contact; ``end`` an ``End``:
 separated, rest, left or duration; ``records``); the plate's contact forces are kept as
@@ -48,6 +50,7 @@ from tailbeam.solvers.stream.driver.loads import PlateLoads
 from tailbeam.solvers.stream.driver.membership import Membership
 from tailbeam.solvers.stream.driver.records import ContactRecords
 from tailbeam.solvers.stream.driver.set_events import SetEvents
+from tailbeam.solvers.stream.driver.sleep import Sleepers
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_REST_SPEED = 0.01  # m/s, the rigid and coupled solvers' value
@@ -124,6 +127,7 @@ def solve_stream(
     contacts=None,
     frames=(),
     friction=None,
+    sleep=True,
 ) -> StreamRun:
     """Simulate a stream of particles on an inclined plate.
 
@@ -159,8 +163,13 @@ def solve_stream(
         Friction and rolling resistance of every contact, the balls' rotation
         (``tailbeam.physics.friction``; on the modal plate also between the balls and the
         plate's top surface, the force's moment driving the modes). None: frictionless.
-        With friction no contact is put at rest (``rest_speed`` and SETTLE unused): a ball
-        on the plate is integrated for as long as it touches it.
+        With friction no contact is put at rest by ``rest_speed`` or SETTLE: a ball on the
+        plate is integrated while it touches it, until its cluster is frozen (``sleep``, on
+        the rigid plate only).
+    sleep : bool
+        With friction on the rigid plate: freeze resting clusters
+        (``tailbeam.solvers.stream.driver.sleep``); False integrates them for as long as
+        they rest.
 
     Returns
     -------
@@ -180,7 +189,7 @@ def solve_stream(
         if plate is not None:
             plate.reset()
         sim = _Stream(particles, incline, duration, contacts, rtol, rest_speed, max_work, plate,
-                      friction, frames)  # fmt: skip
+                      friction, frames, sleep)  # fmt: skip
         try:
             run = _run(sim, duration, progress)
         except _Stuck as err:
@@ -247,18 +256,22 @@ class _Stream:
         The contacts' friction (rigid plate), or None.
     frames : sequence of float
         Frame times (s) at which every ball's state is recorded (``FrameRecorder``).
+    sleep : bool
+        With friction: freeze resting clusters (``Sleepers``).
     """
 
     def __init__(self, particles, incline, duration, contacts, rtol, rest_speed, max_events, plate,
-                 friction=None, frames=()):  # fmt: skip
+                 friction=None, frames=(), sleep=True):  # fmt: skip
         self.clock = clock = Clock(duration)
         self.balls = balls = Balls(particles, incline, contacts)
         self.plate, self.max_events, self.rounds = plate, max_events, 0
-        pairs = None
+        pairs, sleep = None, sleep and friction is not None and plate is None
+        hop_speed = rest_speed  # a plate contact ending slower than this holds the ball
         if friction is not None:
             pairs = FrictionPairs(friction, [p.material.name for p in particles], balls.radius,
                                   incline.plate.material.name)  # fmt: skip
-            rest_speed = 0.0  # (never at rest: the ball rolls, slides or is held by friction)
+            rest_speed = 0.0  # (no SETTLE, no slider: the ball rolls, slides or is held)
+            hop_speed = hop_speed if sleep else 0.0  # (held on the plate, integrated on)
 
         def settle_energy(i: int) -> float:
             return 0.5 * balls.mass[i] * rest_speed**2
@@ -270,9 +283,13 @@ class _Stream:
         self.loads = PlateLoads(balls, act.forces)
         self.heap = Predictions(balls, clock, plate)
         parts = (balls, act, clock, self.heap)
-        self.membership = Membership(*parts, self.records, self.loads, self.ledger, plate)
+        sleepers = None
+        if sleep:
+            sleepers = Sleepers(*parts, self.records, self.loads, self.ledger)
+        self.membership = Membership(*parts, self.records, self.loads, self.ledger, plate,
+                                     sleepers)  # fmt: skip
         shared = (*parts, self.membership, self.records, self.loads, self.ledger)
-        self.set_events = SetEvents(*shared, rest_speed)
+        self.set_events = SetEvents(*shared, hop_speed)
         self.heap_events = HeapEvents(*shared, plate)
         self.frames = FrameRecorder(frames, balls, act)
 
@@ -360,6 +377,8 @@ class _Stream:
             if not b.in_set[i]:
                 loads.dead_load(int(i), duration)
         stats.update(act.stats())
+        if self.membership.sleepers is not None:
+            stats["asleep_final"] = self.membership.sleepers.asleep()
         stats["wall_s"] = wall
         stats["contacts"] = len(self.records.contacts)
         rec = self.records

@@ -6,13 +6,15 @@ every closed-form ball that could reach a core ball within SET_HORIZON (certifie
 A core ball that touches nothing any more flies (or slides, resting on the plate) in closed
 form again. A plate contact alone past its rest limit (``records``) is put at rest. On the
 modal plate the set's horizon is also bounded by SHAPE_TRAVEL of lateral travel of its
-landing balls (their mode shapes are refreshed then).
+landing balls (their mode shapes are refreshed then). With friction on the rigid plate, a
+resting cluster of core balls is frozen and a sleeping ball that could be reached wakes its
+cluster (``sleep``).
 """
 
 import numpy as np
 
 from tailbeam.results.records import End
-from tailbeam.solvers.stream.driver.balls import ACTIVE, FLY, GONE, SLIDE
+from tailbeam.solvers.stream.driver.balls import ACTIVE, FLY, GONE, SLEEP, SLIDE
 
 SET_HORIZON = 1e-3  # s: the active set looks this far ahead for balls that could reach it
 SHAPE_TRAVEL = 1e-3  # m: modal plate: mode shapes refreshed after this much lateral travel
@@ -40,10 +42,14 @@ class Membership:
         The energy removed by putting a ball at rest.
     plate : StreamPlate or None
         The modal plate, or None.
+    sleepers : Sleepers or None
+        With friction on the rigid plate: freezing resting clusters (``sleep``); None: never.
     """
 
-    def __init__(self, balls, act, clock, heap, records, loads, ledger, plate=None):
+    def __init__(self, balls, act, clock, heap, records, loads, ledger, plate=None,
+                 sleepers=None):  # fmt: skip
         self.balls, self.act, self.clock, self.plate = balls, act, clock, plate
+        self.sleepers = sleepers
         self.heap, self.records, self.loads, self.ledger = heap, records, loads, ledger
         self.core = set()  # balls with a contact in progress (and landing balls)
         self.landing = set()  # modal plate: balls within the deflection bound, touching nothing
@@ -103,6 +109,10 @@ class Membership:
         b, t = self.balls, self.clock.t
         self.held = {i: th for i, th in self.held.items() if th == t}
         self._persistent_to_rest()
+        if self.sleepers is not None and self.core:
+            excluded = set(self.landing) | set(self.held)
+            for i in self.sleepers.check(self.core, excluded):
+                self.core.discard(i)
         for i in [i for i in self.core if not self._is_core(i)]:
             self._release_from_core(i)
         core = np.array(sorted(self.core), dtype=np.int64)
@@ -119,7 +129,8 @@ class Membership:
         for i in cand[near & ~b.in_set[cand]]:
             self._absorb(int(i))
         for i in cand[~near & b.in_set[cand]]:
-            self._exit(int(i))
+            if b.status[i] != ACTIVE:  # (not a ball of a cluster woken just now)
+                self._exit(int(i))
 
     def _horizon(self, core) -> float:
         """The set's horizon (s): SET_HORIZON ahead, or a core ball's rest limit, or (modal
@@ -201,8 +212,14 @@ class Membership:
 
     # --- balls entering and leaving the set ---------------------------------------------------
     def _absorb(self, i: int) -> None:
-        """Closed-form ball i becomes a member (a slider's dead load ends)."""
+        """Closed-form ball i becomes a member (a slider's dead load ends; a sleeping ball
+        wakes its cluster)."""
         b, t = self.balls, self.clock.t
+        if b.in_set[i]:  # (woken with its cluster)
+            return
+        if b.status[i] == SLEEP:
+            self.sleepers.wake(i, self._make_core)
+            return
         if b.status[i] == SLIDE:
             self.loads.dead_load(i, t)
         x, v = b.state(i, t)

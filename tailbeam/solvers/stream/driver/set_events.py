@@ -4,7 +4,9 @@ The active set (``tailbeam.solvers.stream.active.members``) integrates its membe
 target time, its horizon or its own next event (an ``EventCode``): a contact start or end,
 a plate contact settling (REST), a ball leaving over an edge; the kinks it passed are logged
 as events. A plate contact that ends slower than ``rest_speed`` (or that ends and starts
-again at one instant, grazing) leaves the ball at rest on the plate.
+again at one instant, grazing) leaves the ball at rest on the plate; with friction (rigid
+plate, sleeping on) a plate contact ending slower than ``rest_speed`` goes on: the ball is
+held on the plate at its static penetration and integrated on (rolling, sliding or held).
 """
 
 from tailbeam.results.records import PLATE, End, EventCode
@@ -88,6 +90,12 @@ class SetEvents:
             # instant: it rests on the plate (with friction it rolls or is held on)
             slow = True
             self.clock.count("grazing_rests")
+        if slow and not others and self.act.friction is not None:
+            # with friction: held on the plate, its contact going on (rolling, sliding or
+            # held by friction: ``sleep``); the slow rebound's energy is removed
+            self.ledger.removed_at_rest(self.act.make_quiet(i))
+            self.clock.count("slow_rebounds_held")
+            return
         self.records.close(key, End.REST if slow and not others else End.SEPARATED)
         self.loads.flush(i)
         if slow and not others:

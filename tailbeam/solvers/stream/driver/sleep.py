@@ -1,0 +1,212 @@
+"""Balls at rest with friction: a resting cluster is frozen (asleep) and costs nothing.
+
+With friction (rigid plate) no contact is put at rest by the frictionless rules: the
+regularised law holds a ball by a creep below the stiction velocity v_s, so a resting lump
+would be integrated (and creep) for as long as it rests. Instead, at every refresh of the
+active set (at least every ``membership.SET_HORIZON``):
+
+* a core ball is SLOW while its centre speed is below SLEEP_SPEED (the frictionless rest
+  speed: what is left then is mostly the normal oscillation of its contacts, lightly damped
+  at the static penetration, and the creep of the regularised law) and the slip and rolling
+  speeds at each of its touching contacts are below their smallest stiction velocity v_s
+  (a spin about a contact normal, free in the model, is not looked at and is dropped when
+  the ball is frozen);
+* a CLUSTER is a connected set of core balls through touching ball-ball contacts, at least
+  one of them touching the plate; it is frozen when every ball of it has been slow for
+  SLEEP_DWELL, and the rigid statics of its contacts admit equilibrium within the Coulomb
+  and rolling limits (``statics.in_equilibrium``; refused: slow again from now);
+* frozen, its balls leave the active set and are ASLEEP (``balls.SLEEP``): velocity and
+  angular velocity exactly zero, position fixed, their contacts at the penetrations they
+  had (their records end as ``rest``; the kinetic energy dropped is counted in
+  ``rest_energy_removed``, the contacts' elastic energy stays with the balls);
+* a sleeping ball that something could reach (a closed-form ball's predicted touch, or a
+  core ball within the set's reach) wakes its whole cluster: the balls rejoin the active
+  set at rest with their contacts touching (resumed contact records) and are integrated
+  until they are frozen again or move off.
+"""
+
+import numpy as np
+
+from tailbeam.results.records import End
+from tailbeam.solvers.stream.driver.balls import SLEEP
+from tailbeam.solvers.stream.driver.statics import in_equilibrium
+
+SLEEP_DWELL = 0.02  # s: a cluster is frozen after its balls have been slow this long
+SLEEP_SPEED = 0.01  # m/s: a slow ball's centre speed bound (its normal oscillation included)
+
+
+class Sleepers:
+    """The slow balls, the frozen clusters, freezing and waking.
+
+    Parameters
+    ----------
+    balls : Balls
+        The stream's balls (``SLEEP``: asleep).
+    act : ActiveMembers
+        The active set (with friction: ``act.friction``).
+    clock : Clock
+        The driver's time and counters (``sleeps``, ``wakes``, ``sleep_refused``).
+    heap : Predictions
+        The closed-form balls' predictions (a frozen ball's touches are predicted).
+    records : ContactRecords
+        The contacts (ended at freezing, resumed at waking).
+    loads : PlateLoads
+        The plate's loads (a frozen ball's force history is flushed).
+    ledger : EnergyLedger
+        The kinetic energy dropped by freezing.
+    """
+
+    def __init__(self, balls, act, clock, heap, records, loads, ledger):
+        self.balls, self.act, self.clock, self.heap = balls, act, clock, heap
+        self.records, self.loads, self.ledger = records, loads, ledger
+        self.slow_since = {}  # core ball -> time (s) since which it has been slow
+        self.cluster = {}  # sleeping ball -> the tuple of its frozen cluster
+
+    # --- freezing -----------------------------------------------------------------------------
+    def check(self, core, excluded) -> list:
+        """Freeze the clusters of ``core`` (set of ball numbers) ready to sleep; balls in
+        ``excluded`` are not frozen now. Returns the balls frozen."""
+        t = self.clock.t
+        touching = {}
+        for key in self.act.touching_keys():
+            for k in key:
+                if k >= 0:
+                    touching.setdefault(k, []).append(key)
+        slow = set()
+        for i in core:
+            if self._is_slow(i, touching.get(i, [])):
+                slow.add(i)
+                self.slow_since.setdefault(i, t)
+            else:
+                self.slow_since.pop(i, None)
+        ready = {i for i in slow if t - self.slow_since[i] >= SLEEP_DWELL} - set(excluded)
+        frozen = []
+        for comp, keys in self._clusters(ready, touching):
+            if not any(k[1] < 0 for k in keys):
+                continue
+            if not self._holds(comp, keys):
+                self.clock.count("sleep_refused")
+                for i in comp:
+                    self.slow_since[i] = t
+                continue
+            self._freeze(comp, keys)
+            frozen.extend(comp)
+        return frozen
+
+    def _is_slow(self, i: int, keys) -> bool:
+        """Ball i touches something (``keys``), its centre moves slower than SLEEP_SPEED,
+        and the slip speed and the rolling speed (rolling radius x the relative angular
+        velocity's part in the contact plane) at each of its contacts are below the
+        contacts' smallest stiction velocity (twisting about a normal is free: not looked
+        at)."""
+        act = self.act
+        if not keys:
+            return False
+        v_s = min(act.friction.settings(k).stiction_velocity for k in keys)
+        _, v = act.state(i)
+        if float(np.linalg.norm(v)) >= SLEEP_SPEED:
+            return False
+        for a, c in keys:
+            xa, va = act.state(a)
+            wa = act.spin(a)
+            if c < 0:
+                partner, n, w = (), np.array([0.0, 0.0, 1.0]), wa
+            else:
+                xc, vc = act.state(c)
+                wc = act.spin(c)
+                partner, n, w = (xc, vc, wc), (xa - xc) / np.linalg.norm(xa - xc), wa - wc
+            roll = act.friction.row((a, c))[6] * float(np.linalg.norm(w - (w @ n) * n))
+            if roll >= v_s or act.friction.slip((a, c), xa, va, wa, *partner) >= v_s:
+                return False
+        return True
+
+    def _clusters(self, ready, touching):
+        """Connected clusters (sorted ball list, their touching keys) of touching balls
+        (``touching``: ball -> its touching keys), kept only when every ball of the cluster
+        is in ``ready``."""
+        seen, out = set(), []
+        for start in sorted(ready):
+            if start in seen:
+                continue
+            comp, keys, todo, whole = [], set(), [start], True
+            seen.add(start)
+            while todo:
+                i = todo.pop()
+                comp.append(i)
+                for key in touching.get(i, []):
+                    keys.add(key)
+                    for k in key:
+                        if k >= 0 and k not in seen:
+                            seen.add(k)
+                            whole &= k in ready
+                            todo.append(k)
+            if whole:
+                out.append((sorted(comp), sorted(keys)))
+        return out
+
+    def _holds(self, comp, keys) -> bool:
+        """The rigid statics of cluster ``comp`` admit equilibrium (``statics``)."""
+        local = {i: q for q, i in enumerate(comp)}
+        x = np.array([self.act.state(i)[0] for i in comp])
+        rows = []
+        for key in keys:
+            s, row = self.act.friction.settings(key), self.act.friction.row(key)
+            i, j = key
+            rows.append((local[i], -1 if j < 0 else local[j], row[5], s.static, s.rolling, row[6]))
+        b = self.balls
+        return in_equilibrium(x, b.mass[comp], b.g, rows)
+
+    def _freeze(self, comp, keys) -> None:
+        """Cluster ``comp`` (touching through ``keys``) is asleep from now."""
+        b, act, t, ledger = self.balls, self.act, self.clock.t, self.ledger
+        removed = 0.0
+        for key in keys:
+            if self.records.is_open(key):
+                self.records.close(key, End.REST)
+        states = {}
+        for i in comp:
+            x, v = act.state(i)
+            w = act.spin(i)
+            removed += 0.5 * b.mass[i] * float(v @ v)
+            removed += 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
+            ledger.asleep[i] = act.elastic_energy_of(i)
+            states[i] = x
+        ledger.removed_at_rest(removed)
+        members = tuple(comp)
+        for i in comp:
+            self.loads.flush(i)
+            act.remove(i)
+            b.in_set[i] = False
+            b.w[i] = 0.0
+            b.set_motion(i, SLEEP, t, states[i], np.zeros(3))
+            self.cluster[i] = members
+            self.slow_since.pop(i, None)
+        for i in comp:
+            self.heap.predict(i)
+        self.clock.count("sleeps")
+        self.clock.count("balls_put_to_sleep", len(comp))
+
+    # --- waking -------------------------------------------------------------------------------
+    def wake(self, i: int, make_core) -> list:
+        """Sleeping ball i is about to be touched: its cluster rejoins the active set at rest,
+        its contacts touching (their records start again); ``make_core(k)`` makes each ball
+        core. Returns the cluster's balls."""
+        b, act = self.balls, self.act
+        comp = self.cluster[i]
+        for k in comp:
+            act.add(k, b.x0[k].copy(), np.zeros(3), quiet=False)
+            b.in_set[k] = True
+            self.cluster.pop(k, None)
+            self.ledger.asleep.pop(k, None)
+        for k in comp:
+            make_core(k)  # (status ACTIVE; its plate contact's record)
+        for k in comp:
+            for key in act.touching_pairs(k):
+                if key[1] >= 0 and not self.records.is_open(key):
+                    self.records.start(key)
+        self.clock.count("wakes")
+        return list(comp)
+
+    def asleep(self) -> int:
+        """How many balls are asleep now."""
+        return int(np.count_nonzero(self.balls.status == SLEEP))
