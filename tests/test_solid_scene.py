@@ -8,7 +8,7 @@ import csv
 
 import numpy as np
 import pytest
-from solid_meshes import plate_mesh
+from solid_meshes import clamped_plate_scenes, plate_mesh
 
 from tailbeam.cli.main import main
 from tailbeam.io.scene_dump import dumps_scene
@@ -30,26 +30,7 @@ SENSOR = """
 name = "S1"
 position = [-0.1, 0.12]
 """
-STRUCTURE = f"""duration = 0.002
-[plate]
-model = "modal"
-mesh = "meshes/plate.msh"
-impact_face = "top"
-fmax = {FMAX}
-tail = "quasi-static"
-[[plate.supports]]
-group = "sides"
-kind = "clamped"
-"""
-FLAT = f"""duration = 0.002
-[plate]
-model = "modal"
-size = [0.6, 0.6, 0.01]
-boundary = "CCCC"
-theory = "mindlin"
-fmax = {FMAX}
-tail = "quasi-static"
-"""
+STRUCTURE, FLAT = clamped_plate_scenes("meshes/plate.msh", 0.002, FMAX)
 # The solid's static compliance under the contact disc is 1.6 % below the Mindlin plate's
 # on the 24 x 24 x 1 clamped plate (docs/structures.md): the contact sees that compliance in
 # series with the Hertz contact, so restitution and peak force may differ by at most that.

@@ -16,7 +16,7 @@ face, static compliance for the residual flexibility).
 
 import numpy as np
 import pytest
-from solid_meshes import plate_mesh
+from solid_meshes import clamped_plate_scenes, plate_mesh
 from test_stream_solver import _particles, _worst_difference
 
 import tailbeam
@@ -49,26 +49,7 @@ radius = 0.025
 position = [-0.12, 0.1, 0.03]
 velocity = [0.0, 0.0, -1.0]
 """
-STRUCTURE = f"""duration = 0.01
-[plate]
-model = "modal"
-mesh = "plate.msh"
-impact_face = "top"
-fmax = {FMAX}
-tail = "quasi-static"
-[[plate.supports]]
-group = "sides"
-kind = "clamped"
-"""
-FLAT = f"""duration = 0.01
-[plate]
-model = "modal"
-size = [0.6, 0.6, 0.01]
-boundary = "CCCC"
-theory = "mindlin"
-fmax = {FMAX}
-tail = "quasi-static"
-"""
+STRUCTURE, FLAT = clamped_plate_scenes("plate.msh", 0.01, FMAX)
 
 
 @pytest.fixture(scope="module")
