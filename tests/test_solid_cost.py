@@ -148,3 +148,21 @@ def test_a_cached_structure_is_costed_as_its_reading(tmp_path, monkeypatch):
     eigen = estimate_run(scene, solver).part("eigen-solve")
     assert eigen.cached and "cached" in eigen.driver
     assert plan_bases(scene, stream=False).n_modes == len(basis.frequencies_hz)
+
+
+def test_a_three_axis_sensor_costs_as_three_sensors(tmp_path, monkeypatch):
+    """Replay and writing count signals: a sensor with axes = "xyz" as three along x, y, z."""
+    plate_mesh(str(tmp_path / "plate.msh"), divisions=12)
+    monkeypatch.chdir(tmp_path)
+    point = "position = [-0.1, 0.05, -0.01]\nsample_rate = 25600.0\n"
+    three_axis = f'[[sensors]]\nname = "back"\n{point}axes = "xyz"\n'
+    units = {"x": "[1, 0, 0]", "y": "[0, 1, 0]", "z": "[0, 0, 1]"}
+    three = "".join(
+        f'[[sensors]]\nname = "{a}"\n{point}direction = {d}\n' for a, d in units.items()
+    )
+    costs = []
+    for sensors in (three_axis, three):
+        scene = loads_scene(STRUCTURE_SCENE + sensors)
+        costs.append(estimate_run(scene, choose_solver(scene, "auto")))
+    for part in ("sensor replay", "writing"):
+        assert costs[0].part(part).time_s == costs[1].part(part).time_s

@@ -243,13 +243,14 @@ def replay_part(sensors, duration: float, n_modes: int, top_hz: float, particles
 
 
 def write_part(scene, timeseries: bool, sensors: bool) -> Part:
-    """The CSV files and the sensors' figures."""
+    """The CSV files and the sensors' figures (one column and figure per signal: per axis)."""
+    signals = [c for s in scene.sensors for c in s.channels()] if sensors else []
     values = 0.0
     if timeseries:
         values += (scene.duration * scene.sample_rate + 1) * (1 + 3 * len(scene.balls))
-    samples = sum(scene.duration * s.sample_rate + 1 for s in scene.sensors) if sensors else 0.0
+    samples = sum(scene.duration * s.sample_rate + 1 for s in signals)
     values += 1.5 * samples  # sensors.csv and the spectra (half the samples)
-    figures = len(scene.sensors) if sensors else 0
+    figures = len(signals)
     time_s = WRITE_BASE + WRITE_VALUE * values + FIGURE_SAMPLE * samples
     time_s += (PLOT_BASE + figures * FIGURE_BASE) if figures else 0.0
     return Part("writing", time_s, BASE_MEMORY + 8.0 * 3 * values, f"{values:.3g} values")

@@ -81,7 +81,8 @@ def estimate_run(scene, solver, *, band: dict | None = None, writes: bool = True
         particles = len(scene.particles) if solver.stream else 0
         ritz_dofs = plan.n_dofs if plan.ritz_points else 0
         balls = 0 if solver.stream else len(scene.balls)
-        parts.append(replay_part(scene.sensors, scene.duration, n_modes, top_hz, particles,
+        signals = [c for s in scene.sensors for c in s.channels()]  # one per axis
+        parts.append(replay_part(signals, scene.duration, n_modes, top_hz, particles,
                                  ritz_dofs, balls))  # fmt: skip
     if writes:
         parts.append(write_part(scene, not solver.stream, modal_sensors))
