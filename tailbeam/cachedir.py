@@ -9,6 +9,7 @@ example ``pip install .`` then ``pip install -e .``) cannot leave stale files in
 import hashlib
 import os
 import sys
+import tempfile
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parent
@@ -54,12 +55,29 @@ def configure_numba_cache() -> Path:
     """
     if os.environ.get("NUMBA_CACHE_DIR"):
         return Path(os.environ["NUMBA_CACHE_DIR"])
-    folder = numba_cache_dir()
+    folder = _writable(numba_cache_dir())
     if "numba" in sys.modules:  # numba read its environment already: set its config
         sys.modules["numba"].config.CACHE_DIR = str(folder)
     else:
         os.environ["NUMBA_CACHE_DIR"] = str(folder)
     return folder
+
+
+def _writable(folder: Path) -> Path:
+    """``folder``, created; if it cannot be, the same fingerprint's folder under the system's
+    temporary folder, with a line on stderr saying why (numba, left with a folder it cannot
+    write, would cache into the installed package instead)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        return folder
+    except OSError as err:
+        spare = Path(tempfile.gettempdir()) / f"tailbeam-{os.getuid()}" / "numba" / folder.name
+        sys.stderr.write(
+            f"tailbeam: cannot create the cache folder {folder} ({err.strerror}); compiled "
+            f"kernels go to {spare}: set TAILBEAM_CACHE_DIR to a writable folder\n"
+        )
+        spare.mkdir(parents=True, exist_ok=True)
+        return spare
 
 
 # First-run compile time of each solver's kernels, measured on the 2-core machine (examples

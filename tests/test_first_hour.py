@@ -59,6 +59,24 @@ def test_numba_cache_lives_outside_the_package(tmp_path):
     assert not list(package.rglob("*.nbi")) and not list(package.rglob("*.nbc"))
 
 
+def test_an_unwritable_cache_folder_is_said_and_kept_out_of_the_package(tmp_path):
+    """A cache folder that cannot be created (here: under a file) gets one line naming
+    TAILBEAM_CACHE_DIR, and the kernels go to the system's temporary folder, not into the
+    package (where numba falls back to when its folder cannot be written)."""
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    env = dict(os.environ, TAILBEAM_CACHE_DIR=str(blocker / "cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    code = "import tailbeam, numba; print(numba.config.CACHE_DIR)"
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    )
+    folder = Path(out.stdout.strip())
+    assert folder.is_dir() and folder.name == source_fingerprint()
+    assert Path(tailbeam.__file__).parent not in folder.parents
+    assert out.stderr.count("\n") == 1 and "TAILBEAM_CACHE_DIR" in out.stderr
+
+
 def test_numba_cache_follows_every_source_file(tmp_path):
     """numba checks a cached kernel against its own file only; the cache folder is keyed by
     every tailbeam source file, so editing any module (a helper a kernel calls or inlines, a
