@@ -183,6 +183,24 @@ def test_sensor_figure_states_position_resolution_peak_rms():
     assert buf.getvalue()[:4] == b"\x89PNG"
 
 
+@pytest.mark.parametrize("band_hz", [2000.0, 30000.0])
+def test_sensor_figure_marks_the_modal_band_below_the_bandwidth(band_hz):
+    """A band below the plotted 20 kHz is a dotted line at its top on both spectra, the
+    spectrogram's line at the same height, and a title line; a band above: nothing."""
+    fig = build_sensor_figure(sine_output(), band_hz=band_hz)
+    _time, spectrum, welch, spectrogram = fig.axes[:4]
+    dotted = [
+        [line for line in ax.get_lines() if line.get_linestyle() == ":"]
+        for ax in (spectrum, welch, spectrogram)
+    ]
+    below = band_hz < 20000.0
+    assert [len(lines) for lines in dotted] == [int(below)] * 3
+    if below:
+        assert all(line.get_xdata()[0] == band_hz / 1e3 for line in dotted[0] + dotted[1])
+        assert dotted[2][0].get_ydata()[0] == band_hz / 1e3
+    assert (f"modes to {band_hz:g} Hz (dotted line)" in texts(fig)) == below
+
+
 def test_scenario_figures_have_nothing_cut_off(material):
     t = figures.plot_grid(material, 20000.0)
     states = material.sample(t)

@@ -108,11 +108,12 @@ def _write_sensors(out_dir, scene, result, outputs, bar) -> list:
             sensors=meta,
         ),
     ]
+    band_hz = result.info.get("band", {}).get("fmax_hz")
     for name, out in outputs.items():
         position = tuple(meta[name]["position_m"])
         direction = meta[name].get("direction")
         files.append(sensor_figure(out, out_dir / f"sensor_{name}.png", position=position,
-                                   direction=direction))  # fmt: skip
+                                   direction=direction, band_hz=band_hz))  # fmt: skip
         bar.update(1)
     return files
 

@@ -151,15 +151,15 @@ def _spectrogram_panel(fig, ax, output, stats, f_max):
     )
 
 
-def sensor_figure(output, path, *, position=None, direction=None) -> Path:
-    """Write build_sensor_figure(output, position, direction) to ``path`` (PNG); returns the
-    path."""
+def sensor_figure(output, path, *, position=None, direction=None, band_hz=None) -> Path:
+    """Write build_sensor_figure(output, position, direction, band_hz) to ``path`` (PNG);
+    returns the path."""
     path = Path(path)
-    build_sensor_figure(output, position, direction).savefig(path, dpi=110)
+    build_sensor_figure(output, position, direction, band_hz).savefig(path, dpi=110)
     return path
 
 
-def build_sensor_figure(output, position=None, direction=None) -> Figure:
+def build_sensor_figure(output, position=None, direction=None, band_hz=None) -> Figure:
     """One sensor's record as a 2 x 2 figure: acceleration against time (peak and RMS marked),
     the whole-record amplitude spectrum (with its resolution fs/N), a Welch PSD and a
     spectrogram, all up to the sensor's usable bandwidth.
@@ -172,6 +172,10 @@ def build_sensor_figure(output, position=None, direction=None) -> Figure:
         The sensor's position on the plate or structure, written in the title.
     direction : (dx, dy, dz), optional
         The sensor's measuring direction (unit, plate frame), written in the title.
+    band_hz : float, optional
+        The top of the modal band (Hz). Below the sensor's bandwidth it is marked (dotted) on
+        the spectra and the spectrogram, and the title says that above it the record holds
+        only the truncated modes' contact tails and static response.
 
     Returns
     -------
@@ -200,13 +204,23 @@ def build_sensor_figure(output, position=None, direction=None) -> Figure:
     for ax in (ax_t, ax_f, ax_w):
         ax.grid(alpha=0.3)
     where = _where(position, direction)
-    fig.suptitle(
-        f"sensor {output.name}{where}: fs = {chain.sample_rate:g} Hz, usable band to "
-        f"{chain.bandwidth_hz:g} Hz (plots stop there), mounted resonance "
-        f"{chain.mounted_resonance_hz:g} Hz",
-        fontsize=10,
-    )
+    title = (f"sensor {output.name}{where}: fs = {chain.sample_rate:g} Hz, usable band to "
+             f"{chain.bandwidth_hz:g} Hz (plots stop there), mounted resonance "
+             f"{chain.mounted_resonance_hz:g} Hz")  # fmt: skip
+    if band_hz is not None and band_hz < f_max:
+        _mark_band(ax_f, ax_w, ax_s, band_hz)
+        title += (f"\nmodes to {band_hz:g} Hz (dotted line); above it only the truncated "
+                  "modes' contact tails and static response")  # fmt: skip
+    fig.suptitle(title, fontsize=10)
     return fig
+
+
+def _mark_band(ax_f, ax_w, ax_s, band_hz: float) -> None:
+    """The modal band's top (Hz) as a dotted line on the spectra and the spectrogram."""
+    for ax in (ax_f, ax_w):
+        ax.axvline(band_hz / 1e3, ls=":", lw=1.2, color="0.25")
+    if ax_s.axison:
+        ax_s.axhline(band_hz / 1e3, ls=":", lw=1.2, color="white")
 
 
 def _where(position, direction) -> str:
