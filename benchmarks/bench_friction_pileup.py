@@ -23,12 +23,12 @@ load (``os.getloadavg``) before and after: the machine may be shared.
 import argparse
 import json
 import os
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from child import run_case_in_child
 
 RATE = 100.0  # lumps per second
 
@@ -100,13 +100,7 @@ def _slow(run, speed: float = 1e-3) -> int:
 
 
 def _in_child(n: int, sleep: bool, extra: float = 1.0) -> dict:
-    here = str(Path(__file__).parent)
-    code = (f"import json, sys; sys.path.insert(0, {here!r}); import bench_friction_pileup as b; "
-            f"print(json.dumps(b.run_case({n}, {sleep}, {extra!r})))")  # fmt: skip
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    if done.returncode:
-        raise RuntimeError(done.stderr[-2000:])
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    return run_case_in_child("bench_friction_pileup", n, sleep, extra)
 
 
 def compare(a: dict, b: dict) -> dict:

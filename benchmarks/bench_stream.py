@@ -36,12 +36,12 @@ DIR/results.json and every case's scene and results (DIR/<case>.toml, DIR/<case>
 import argparse
 import json
 import re
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from child import run_case_in_child
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "caving_stream.toml"
@@ -120,17 +120,9 @@ def rms_below(t, a, f_hz: float) -> float:
 def _in_child(out_dir: Path, name: str, text: str, rtol: float = 1e-10) -> dict:
     path = out_dir / f"{name}.toml"
     path.write_text(text)
-    here = str(Path(__file__).parent)
-    code = (
-        f"import json, sys; sys.path.insert(0, {here!r}); import bench_stream as b; "
-        f"print(json.dumps(b.run_case({str(path)!r}, {rtol!r})))"
-    )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    if done.returncode:
-        raise RuntimeError(done.stderr[-2000:])
-    line = done.stdout.strip().splitlines()[-1]
-    (out_dir / f"{name}.json").write_text(line)  # (every case kept: comparisons can be redone)
-    return json.loads(line)
+    result = run_case_in_child("bench_stream", str(path), rtol)
+    (out_dir / f"{name}.json").write_text(json.dumps(result))  # (every case kept)
+    return result
 
 
 def _worst(a: dict, b: dict) -> float:
