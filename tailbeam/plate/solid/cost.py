@@ -40,19 +40,19 @@ returned modes.
 import math
 from dataclasses import dataclass
 
+# ARPACK's shift-invert loop is the flat plate's: its solve rate, orthogonalisation rate and
+# solve count (2 nev + 25: 73-210 solves for 24-85 eigenpairs on the test meshes, 287 for
+# 123 and 999 for 479 on the example beam, within 10 %)
+from tailbeam.plate.fe.cost import ORTH_PER_FLOP, SOLVE_PER_ENTRY, SOLVES_BASE, SOLVES_PER_MODE
+
 FILL = 0.2  # factor entries / (nnz(K) N^(1/3)), nested dissection (module docstring)
 ORDER_PER_NNZ = 3.5e-7  # s per nonzero of K: METIS ordering and the graph's copies (3.1-4.6e-7)
 FACTOR_PER_FLOP = 1.7e-10  # s per F^2/N: SuperLU's factorisation (measured 1.5-1.9e-10)
-SOLVE_PER_ENTRY = 2.0e-9  # s per factor entry and solve: forward and back (1.75-2.1e-9)
 MATVEC_PER_NNZ = 3.0e-9  # s per nonzero of M and solve: ARPACK's product with M (*)
-ORTH_PER_FLOP = 1.0e-9  # s per flop of Lanczos orthogonalisation, memory-bound dgemv (*)
-SOLVES_PER_MODE = 2.0  # ARPACK solves per eigenpair (nev) with ncv = 1.5 nev + 20 (**)
-SOLVES_BASE = 25.0  # solves beyond 2 nev (**)
 FACTOR_BYTES = 12.0  # bytes per factor entry: a double and an int32 row index
 MATRIX_COPIES = 4.0  # K, M, K - sigma M and its permuted CSC copy held at once
-# (*) the rest of a Lanczos step, 7 ms on 11 385 DOFs and 147 vectors, split between them.
-# (**) 73-210 solves for 24-85 eigenpairs on the test meshes, 287 for 123 and 999 for 479 on
-# the example beam: 2 nev + 25 within 10 %.
+# (*) the rest of a Lanczos step, 7 ms on 11 385 DOFs and 147 vectors, with the
+# orthogonalisation at the flat plate's rate
 BASE_MEMORY = 2.1e8  # bytes: interpreter, numpy/scipy/skfem (the smallest mesh's peak)
 
 
