@@ -36,7 +36,7 @@ class Readings:
         self.basis = basis
         self.channels = tuple(channels)
         self.model = getattr(basis, "model", None)  # a StructureModel, or None: the flat plate
-        self._columns = None
+        self._columns = self._shapes = None
         self.static = None
         if getattr(basis, "static_deflection_at", None) is not None:
             self.static = self._static_solid if self.model is not None else self._static_flat
@@ -66,12 +66,16 @@ class Readings:
         return pts[:, :2], dirs[:, 2]
 
     def shapes(self) -> np.ndarray:
-        """(p, n_modes) modal displacements along each channel's direction, 1/sqrt(kg)."""
-        n = self.basis.n_modes
-        if self.model is not None:
-            return np.asarray(self._operator() @ self.basis.mode_vectors)[:, :n]
-        pts, sign = self._flat()
-        return self.basis.deflection(pts) * sign[:, None]
+        """(p, n_modes) modal displacements along each channel's direction, 1/sqrt(kg)
+        (computed once: ``residual_cross`` reads them at every contact point)."""
+        if self._shapes is None:
+            n = self.basis.n_modes
+            if self.model is not None:
+                self._shapes = np.asarray(self._operator() @ self.basis.mode_vectors)[:, :n]
+            else:
+                pts, sign = self._flat()
+                self._shapes = self.basis.deflection(pts) * sign[:, None]
+        return self._shapes
 
     def _static_flat(self, loads) -> np.ndarray:
         pts, sign = self._flat()
