@@ -32,6 +32,8 @@ class Case:
     sensor: tuple
     gravity: float = 9.80665
     rayleigh: tuple = (0.0, 0.0)
+    sensor_band_hz: float = SENSOR_BAND_HZ
+    sensor_window_s: float = SENSOR_WINDOW_S
 
     @property
     def load_radius(self) -> float:
@@ -42,6 +44,10 @@ class Case:
         return fe_reference(self.model, self.ball, self.law, duration, dt=dt,
                             load_radius=self.load_radius, sensors=[self.sensor],
                             rayleigh=self.rayleigh, gravity=self.gravity, **options)  # fmt: skip
+
+    def read(self, res, t, quasi_static: bool) -> np.ndarray:
+        """The sensor's acceleration (m/s^2) in the coupled result ``res`` at times t (s)."""
+        return res.plate.sample(t, [self.sensor], quasi_static=quasi_static)["a"][0]
 
 
 def modal_errors(case: Case, basis, ref, **options) -> dict:
@@ -67,11 +73,11 @@ def result_errors(case: Case, res, ref) -> dict:
     # filtered at the reference's own step: decimating first would alias the FE model's
     # high modes (up to MHz) into the band
     t = ref.t
-    a_ref = in_band(t, ref.sensor_a[0], SENSOR_BAND_HZ)
-    win = t <= SENSOR_WINDOW_S
+    a_ref = in_band(t, ref.sensor_a[0], case.sensor_band_hz)
+    win = t <= case.sensor_window_s
     for key, qs in (("sensor", True), ("sensor_no_qs", False)):
-        a = res.plate.sample(t, [case.sensor], quasi_static=qs)["a"][0]
-        out[key] = relative_l2(in_band(t, a, SENSOR_BAND_HZ)[win], a_ref[win])
+        a = case.read(res, t, qs)
+        out[key] = relative_l2(in_band(t, a, case.sensor_band_hz)[win], a_ref[win])
     return out
 
 

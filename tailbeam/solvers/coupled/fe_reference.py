@@ -21,6 +21,9 @@ parabola through the three nodes around the largest one; the contacts are ``Impa
 (``tailbeam.solvers.coupled.solver``) but the mesh, the element assembly and the contact law's
 formula.
 
+``integrate`` is the same run on any FE model given its load vector and sensor operator
+(a structure: ``tailbeam.solvers.coupled.fe_structure``).
+
 Use ``fe_time_step_study`` to show the step's convergence (order ~2) and to estimate the error.
 """
 
@@ -56,7 +59,9 @@ class FEReferenceResult:
     info: dict = field(default_factory=dict)
 
 
-def _check(ball, law, model, duration, dt, load_radius):
+def check_inputs(ball, law, model, duration, dt, load_radius):
+    """InputError (one line, naming the argument) for what the reference cannot run; ``model``
+    needs ``plate`` (the impact face's rectangle)."""
     if not isinstance(ball, Ball):
         raise InputError("ball", "must be a Ball")
     if not isinstance(law, ImpactLaw):
@@ -76,14 +81,16 @@ def _check(ball, law, model, duration, dt, load_radius):
 class _Plate:
     """The Newmark plate: K_eff factorised once; predictor and correction per step."""
 
-    def __init__(self, model, dt, rayleigh, load):
+    def __init__(self, model, dt, rayleigh, load, factorize=None):
         alpha, beta = rayleigh
         self.K, self.M = model.stiffness, model.mass
         self.C = alpha * self.M + beta * self.K if (alpha, beta) != (0.0, 0.0) else None
         self.c0, self.c1 = 4.0 / dt**2, 2.0 / dt
         keff = (1.0 + self.c1 * beta) * self.K + (self.c0 + self.c1 * alpha) * self.M
-        keff = keff.tocsc()
-        self.lu = spla.splu(keff, permc_spec="MMD_AT_PLUS_A")
+        if factorize is None:
+            self.lu = spla.splu(keff.tocsc(), permc_spec="MMD_AT_PLUS_A")
+        else:
+            self.lu = factorize(keff)
         self.f = load
         self.g = self.lu.solve(load)  # end-of-step plate answer to a unit contact force
         self.s_w = float(load @ self.g)
@@ -168,7 +175,22 @@ def fe_reference(
     rayleigh: (alpha 1/s, beta s). Raises WorkLimitError (before any work) if the estimated
     cost, steps x (factor + matrix nonzeros), exceeds max_work.
     """
-    _check(ball, law, model, duration, dt, load_radius)
+    check_inputs(ball, law, model, duration, dt, load_radius)
+    load = model.load_vector(ball.position[:2], load_radius)
+    probe = model.deflection_operator(np.reshape(sensors, (-1, 2))) if len(sensors) else None
+    return integrate(model, ball, law, duration, dt=dt, load=load, probe=probe,
+                     rayleigh=rayleigh, gravity=gravity, max_work=max_work,
+                     info={"load_radius": load_radius})  # fmt: skip
+
+
+def integrate(model, ball, law, duration, *, dt, load, probe, rayleigh=(0.0, 0.0),
+              gravity=STANDARD_GRAVITY, max_work=DEFAULT_MAX_WORK, info=None,
+              factorize=None) -> FEReferenceResult:  # fmt: skip
+    """The Newmark run of ``fe_reference`` on any FE model (``stiffness``, ``mass`` on its
+    DOFs, ``n_dofs``): ``load`` (n,) the contact's unit load vector (the deflection under the
+    ball is load . u), ``probe`` a (p, n) sparse operator of the sensor readings (or None),
+    ``factorize`` a factoriser of the effective stiffness (an object with ``solve``; None:
+    SuperLU with minimum degree). Inputs checked by the caller (``check_inputs``)."""
     n_steps = int(math.ceil(duration / dt - 1e-9))
     nnz = model.stiffness.nnz + model.mass.nnz
     if n_steps * 10 * nnz > max_work:
@@ -177,9 +199,7 @@ def fe_reference(
             f"{model.n_dofs} DOFs) > max_work={max_work:.2g}; raise dt or max_work, or use a "
             "coarser mesh"
         )
-    load = model.load_vector(ball.position[:2], load_radius)
-    plate = _Plate(model, dt, rayleigh, load)
-    probe = model.deflection_operator(np.reshape(sensors, (-1, 2))) if len(sensors) else None
+    plate = _Plate(model, dt, rayleigh, load, factorize)
     with task("FE reference (Newmark)", total=n_steps, unit="steps") as bar:
         hist, vz_hist, sw, sa = _integrate(plate, probe, ball, law, n_steps, gravity, bar)
     t_hist = dt * np.arange(n_steps + 1)
@@ -192,7 +212,7 @@ def fe_reference(
         impacts=_impacts(ball, t_hist, hist, vz_hist, dt),
         dt=dt,
         n_dofs=model.n_dofs,
-        info={"load_radius": load_radius, "rayleigh": tuple(rayleigh), "steps": n_steps},
+        info={**(info or {}), "rayleigh": tuple(rayleigh), "steps": n_steps},
     )
 
 
@@ -211,6 +231,7 @@ def _integrate(plate, probe, ball, law, n_steps, gravity, bar):
     s_v = 2.0 * plate.s_w / dt + dt / (2.0 * m)
     vz_hist = np.empty(n_steps + 1)
     vz_hist[0] = vz
+    chunk = max(1, min(1000, n_steps // 100))  # progress: about every 1 % of the steps
     for k in range(1, n_steps + 1):
         u_hat = plate.predict(u, v, a)
         zb = z + dt * vz + 0.25 * dt**2 * (az - gravity)  # ball with no force at the end
@@ -227,8 +248,8 @@ def _integrate(plate, probe, ball, law, n_steps, gravity, bar):
         if probe is not None:
             sw[:, k] = probe @ u
             sa[:, k] = probe @ a
-        if k % 1000 == 0:
-            bar.update(1000)
+        if k % chunk == 0:
+            bar.update(chunk)
     return hist, vz_hist, sw, sa
 
 
@@ -280,9 +301,11 @@ def impact_quantities(impact) -> dict:
     }
 
 
-def fe_time_step_study(model, ball, law, duration, dts, **options) -> dict:
-    """Run ``fe_reference`` at each step of ``dts`` (decreasing, each half the previous) and
-    measure the convergence of the first impact's quantities.
+def fe_time_step_study(model, ball, law, duration, dts, *, reference=None, **options) -> dict:
+    """Run ``fe_reference`` (or ``reference``, a function of the same arguments, e.g.
+    ``tailbeam.solvers.coupled.fe_structure.structure_fe_reference``) at each step of ``dts``
+    (decreasing, each half the previous) and measure the convergence of the first impact's
+    quantities.
 
     Returns {"runs": [results], "differences": {quantity: [|Q(dt_i) - Q(dt_i+1)| / |Q|]},
     "orders": {quantity: [log2 of successive difference ratios]}, "extrapolated": {quantity:
@@ -292,7 +315,8 @@ def fe_time_step_study(model, ball, law, duration, dts, **options) -> dict:
     dts = [float(d) for d in dts]
     if len(dts) < 2 or any(b >= a for a, b in zip(dts, dts[1:], strict=False)):
         raise InputError("dts", "need at least two decreasing time steps")
-    runs = [fe_reference(model, ball, law, duration, dt=d, **options) for d in dts]
+    reference = reference or fe_reference
+    runs = [reference(model, ball, law, duration, dt=d, **options) for d in dts]
     qs = [impact_quantities(r.impacts[0]) for r in runs]
     diffs, orders, extra, est = {}, {}, {}, {}
     for name in QUANTITIES:
