@@ -179,12 +179,6 @@ BAD = {  # case: (scene, sensor keys, field named, words of the rule)
         "nonzero",
     ),  # fmt: skip
     "axes letters": (MESHED, {"position": "[0.0, 0.0]", "axes": '"xw"'}, "sensors[1].axes", "xyz"),
-    "flat in-plane": (
-        FLAT,
-        {"position": "[0.0, 0.0]", "axes": '"xyz"'},
-        "sensors[1].axes",
-        "normal",
-    ),  # fmt: skip
     "flat inside": (FLAT, {"position": "[0.0, 0.0, -0.005]"}, "sensors[1].position", "bottom"),
     "axis name taken": (
         MESHED,
@@ -228,7 +222,7 @@ def test_library_refuses_a_zero_direction():
         SensorSpec("s", (0.0, 0.0), direction=(0.0, 0.0, 0.0))
 
 
-def test_a_sweep_refuses_a_sensor_with_axes_before_any_case_runs():
+def test_a_sweep_takes_sensors_with_points_directions_and_axes():
     from tailbeam.study.design import expand, parse_sweep
 
     scene = {
@@ -236,8 +230,11 @@ def test_a_sweep_refuses_a_sensor_with_axes_before_any_case_runs():
         "plate": {"model": "modal", "fmax": 3000.0},
         "balls": [{"name": "rock", "material": "coal", "radius": 0.02,
                    "position": [0.0, 0.0, 0.06], "velocity": [0.0, 0.0, -1.0]}],
-        "sensors": [{"name": "S1", "position": [0.1, 0.1], "axes": "z"}],
+        "sensors": [{"name": "S1", "position": [0.1, 0.1], "axes": "zx"},
+                    {"name": "S2", "position": [0.1, 0.1, -0.01], "direction": [0, 3, 4]}],
     }  # fmt: skip
     spec = parse_sweep({"scene": scene, "axes": {"balls[1].radius": [0.02, 0.03]}})
-    with pytest.raises(InputError, match=r"scene\.sensors\[1\]\.axes"):
-        expand(spec)
+    cases = expand(spec)
+    assert len(cases) == 2
+    assert cases[0].sensor_points == ((0.1, 0.1, 0.0), (0.1, 0.1, 0.0), (0.1, 0.1, -0.01))
+    assert cases[0].sensor_directions == ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, 0.6, 0.8))

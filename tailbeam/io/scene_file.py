@@ -473,7 +473,7 @@ def _check_sensor_names(sensors) -> None:
 
 def _check_sensor_place(field: str, spec: SensorSpec, plate: Plate, modal) -> None:
     """A sensor's point lies on the plate or structure; on the flat plate a point (x, y, z)
-    lies on its top (z = 0) or bottom (z = -thickness) face and reads along the normal."""
+    lies on its top (z = 0) or bottom (z = -thickness) face."""
     x, y = spec.position[:2]
     structure = modal is not None and modal.mesh is not None
     if len(spec.position) == 3 and structure:
@@ -491,16 +491,6 @@ def _check_sensor_place(field: str, spec: SensorSpec, plate: Plate, modal) -> No
                 f"z = {z!r} m is {off:.3g} m off the flat plate's surface: a point of its top "
                 f"face has z = 0, of its bottom face z = {-h!r} m",
             )
-    if structure:
-        return
-    directions = [c.direction for c in spec.channels() if c.direction is not None]
-    if any(abs(d[0]) > 0 or abs(d[1]) > 0 for d in directions):
-        key = "axes" if spec.axes is not None else "direction"
-        raise InputError(
-            f"{field}.{key}",
-            "the flat plate is read along its normal only (direction (0, 0, +-1), axes 'z'); "
-            "other directions need a structure from plate.mesh",
-        )
 
 
 def _parse_noise(field: str, value) -> NoiseSpec:

@@ -7,8 +7,10 @@
   ``n_particles``, ``n_ball_contacts``), the modal band ``band_hz`` and the band check's
   estimate of the peak-force error ``band_force_error`` (NaN on the rigid plate), ``valid``
   (that estimate within the sweep's ``band_accuracy``) and ``invalid_reason``, and every
-  swept value (vector values one coordinate per component, ``key[i]``); ``sensor_x``,
-  ``sensor_y`` (case, sensor) in m.
+  swept value (vector values one coordinate per component, ``key[i]``); per case and sensor
+  signal (a sensor, or ``<name>_x``... for each axis of a three-axis one) its point
+  ``sensor_x``, ``sensor_y``, ``sensor_z`` in m and the unit direction it reads along,
+  ``sensor_dx``, ``sensor_dy``, ``sensor_dz``.
   Attributes: units, sample rate (Hz), duration (s), the base sensor positions, the tailbeam
   version, the sweep file, and ``case_scenes`` (case hash -> the case's scene TOML).
   Finished cases are appended along ``case``; open it with ``xarray.open_zarr(DIR/dataset.zarr)``.
@@ -61,6 +63,8 @@ LEDGER_COLUMNS = (
     "seed",
     "repeat",
 )
+# per case and signal: its point (m) and the unit direction it reads along
+SENSOR_COORDS = ("sensor_x", "sensor_y", "sensor_z", "sensor_dx", "sensor_dy", "sensor_dz")
 CHUNK_BYTES = 4 << 20  # target size of one Zarr chunk of signals along case
 CASE_COORD_CHUNK = 4096  # cases per chunk of the per-case coordinates
 
@@ -127,7 +131,8 @@ class DatasetStore:
         missing = stored - known
         if missing:  # finished cases whose ledger row was not written: rebuild from the store
             with xr.open_zarr(self.zarr_path) as ds:
-                coords = ds.drop_vars(["acceleration", "sensor", "time", "sensor_x", "sensor_y"])
+                drop = ["acceleration", "sensor", "time", *SENSOR_COORDS]
+                coords = ds.drop_vars(drop, errors="ignore")
                 df = coords.to_dataframe().reset_index()
             df = df[df["case_hash"].isin(missing)].assign(status="ok", error="")
             self._set_rows(df.to_dict("records"))
@@ -249,7 +254,7 @@ class DatasetStore:
         import xarray as xr
 
         first_scene = loads_scene(ok[0][1].toml)  # what every case shares (design.expand)
-        names = [s.name for s in first_scene.sensors]
+        names = [c.name for s in first_scene.sensors for c in s.channels()]
         fs = first_scene.sensors[0].sample_rate
         acc = np.stack([np.stack([res["signals"][n] for n in names]) for _r, _c, res in ok])
         n_time = acc.shape[-1]
@@ -262,10 +267,11 @@ class DatasetStore:
         for col in [c for c in ok[0][0] if c not in skip]:
             values = np.array([r[col] for r, *_ in ok])
             coords[col] = ("case", values.astype(object) if values.dtype.kind == "U" else values)
-        for axis, unit in ((0, "sensor_x"), (1, "sensor_y")):
-            pos = [[xy[axis] for xy in case.sensor_xy] for _r, case, _res in ok]
-            coords[unit] = (("case", "sensor"), np.array(pos), {"units": "m"})
-        acc_attrs = {"units": "m/s^2", "long_name": "sensor acceleration normal to the plate"}
+        for k, name in enumerate(SENSOR_COORDS):
+            vectors = "sensor_points" if k < 3 else "sensor_directions"
+            values = [[v[k % 3] for v in getattr(case, vectors)] for _r, case, _res in ok]
+            coords[name] = (("case", "sensor"), np.array(values), {"units": "m" if k < 3 else "1"})
+        acc_attrs = {"units": "m/s^2", "long_name": "sensor acceleration along its direction"}
         return xr.Dataset(
             {"acceleration": (("case", "sensor", "time"), acc.astype(np.float32), acc_attrs)},
             coords=coords,

@@ -48,8 +48,9 @@ __all__ = [
 @dataclass(frozen=True)
 class Case:
     """One scene of the sweep: swept values, repeat, seed, scene TOML and its hash, labels,
-    its modal basis key (``case.basis_signature``) and its sensors' (x, y) positions (m): what
-    the client needs of the scene, so it never parses the TOML again."""
+    its modal basis key (``case.basis_signature``), and per output signal (a sensor, or each
+    axis of a three-axis one: ``SensorSpec.channels``) its point (x, y, z) m and unit
+    direction: what the client needs of the scene, so it never parses the TOML again."""
 
     params: dict
     repeat: int
@@ -58,7 +59,8 @@ class Case:
     hash: str
     labels: dict
     basis: str = ""
-    sensor_xy: tuple = ()
+    sensor_points: tuple = ()
+    sensor_directions: tuple = ()
 
 
 def _hash_int(*parts) -> int:
@@ -135,14 +137,25 @@ def make_case(spec: SweepSpec, params: dict, repeat: int, number: int):
     label_balls(data, spec.coal)
     shown = ", ".join(f"{k} = {v!r}" for k, v in params.items())
     try:
-        scene = parse_scene(data)
+        scene = parse_scene(data, base_dir=spec.base_dir)
     except InputError as err:
         raise InputError(f"case {number} ({shown}): {err.field}", err.rule) from None
     toml = dumps_scene(scene) + f"# case seed = {seed}\n"
     digest = hashlib.sha256(toml.encode()).hexdigest()
     labels = case_labels(scene)
-    xy = tuple((float(s.position[0]), float(s.position[1])) for s in scene.sensors)
-    return Case(params, repeat, seed, toml, digest, labels, basis_signature(scene), xy), scene
+    points, directions = _channel_places(scene.sensors)
+    basis = basis_signature(scene)
+    return Case(params, repeat, seed, toml, digest, labels, basis, points, directions), scene
+
+
+def _channel_places(sensors) -> tuple:
+    """((x, y, z) m, (dx, dy, dz)) of every output signal: a point (x, y) is (x, y, 0) on the
+    impact face, the direction by default its normal +z."""
+    points, directions = [], []
+    for c in (c for s in sensors for c in s.channels()):
+        points.append(tuple(float(v) for v in (*c.position, 0.0)[:3]))
+        directions.append(c.direction if c.direction is not None else (0.0, 0.0, 1.0))
+    return tuple(points), tuple(directions)
 
 
 def expand(spec: SweepSpec) -> list:
@@ -152,29 +165,17 @@ def expand(spec: SweepSpec) -> list:
     for params in design_points(spec):
         for r in range(spec.repeats):
             case, scene = make_case(spec, params, r, len(cases) + 1)
-            shape = (scene.duration, tuple((s.name, s.sample_rate) for s in scene.sensors))
+            signals = tuple((c.name, c.sample_rate) for s in scene.sensors for c in s.channels())
+            shape = (scene.duration, signals)
             if first is None:
                 first = shape
                 if not scene.sensors:
                     raise InputError("scene.sensors", "a sweep needs at least one [[sensors]]")
-                _check_plain_sensors(scene.sensors)
             elif shape != first:
                 raise InputError(
                     f"case {len(cases) + 1}",
-                    "changes the duration, sensor names or sensor sample rates; every case "
-                    "of a dataset shares one time axis",
+                    "changes the duration, sensor signal names (sensors, axes) or sample "
+                    "rates; every case of a dataset shares one time axis",
                 )
             cases.append(case)
     return cases
-
-
-def _check_plain_sensors(sensors) -> None:
-    """A dataset's sensors are points (x, y) read along z: InputError naming the first other."""
-    for i, s in enumerate(sensors, start=1):
-        if not s.plain:
-            key = "axes" if s.axes is not None else "direction" if s.direction else "position"
-            raise InputError(
-                f"scene.sensors[{i}].{key}",
-                "a sweep's dataset holds sensors at (x, y) read along z; a point (x, y, z), "
-                "direction or axes is not supported in sweeps",
-            )

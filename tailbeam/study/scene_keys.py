@@ -2,8 +2,9 @@
 their values in a raw scene table.
 
 ``balls.NAME`` or ``balls[i]`` (i from 1, as in error messages) select an entry of an array of
-tables, ``key[i]`` (i from 0) one component of a vector; errors name the axis as the sweep file
-writes it (``axes."KEY"``).
+tables (by its ``name``; an entry without one, a support, by its ``group``:
+``plate.supports.jack.stiffness``), ``key[i]`` (i from 0) one component of a vector; errors
+name the axis as the sweep file writes it (``axes."KEY"``).
 """
 
 import re
@@ -35,7 +36,7 @@ def _entry(key: str, tables: list, name: str, index):
             raise InputError(_field(key), f"index {index} is outside 1..{len(tables)}")
         return tables[index - 1]
     for t in tables:
-        if t.get("name") == name:
+        if t.get("name", t.get("group")) == name:
             return t
     raise InputError(_field(key), f"no entry named {name!r}")
 

@@ -67,8 +67,10 @@ class Axis:
 
 @dataclass(frozen=True)
 class SweepSpec:
-    """A validated sweep file: the base scene table, axes, repeats, seed, coal materials and
-    the largest band-check estimate of a case's peak-force error it accepts as valid."""
+    """A validated sweep file: the base scene table, axes, repeats, seed, coal materials,
+    the largest band-check estimate of a case's peak-force error it accepts as valid, and
+    the folder the cases' paths (``plate.mesh``) are relative to: the base scene file's, or
+    the sweep file's for an inline scene."""
 
     base: dict
     axes: tuple
@@ -77,6 +79,7 @@ class SweepSpec:
     coal: tuple = ("coal",)
     text: str = ""
     band_accuracy: float = BAND_ACCURACY
+    base_dir: str = "."
 
 
 def _whole(field: str, value, low: int) -> int:
@@ -100,6 +103,9 @@ def parse_sweep(data: dict, *, base_dir=".", text: str = "") -> SweepSpec:
     """Validate the parsed sweep table ``data``; a scene path is relative to ``base_dir``."""
     _check_keys("", data, SWEEP_KEYS, required=("scene", "axes"))
     base = _base_scene(data["scene"], Path(base_dir))
+    scene_dir = Path(base_dir)
+    if isinstance(data["scene"], str):  # the scene's own paths are relative to its file
+        scene_dir = (scene_dir / data["scene"]).parent
     labels = data.get("labels", {})
     if not isinstance(labels, dict):
         raise InputError("labels", "must be a table ([labels])")
@@ -116,6 +122,7 @@ def parse_sweep(data: dict, *, base_dir=".", text: str = "") -> SweepSpec:
         coal=tuple(coal),
         text=text,
         band_accuracy=_accuracy(data.get("band_accuracy", BAND_ACCURACY)),
+        base_dir=str(scene_dir),
     )
 
 

@@ -6,10 +6,12 @@ a mesh (a basis with its ``StructureModel``) the point is any point of the surfa
 (x, y) is (x, y, 0) on the impact face), read along the direction (default +z, the impact
 face's normal) by the structure's own displacement operator (``surface_operator``: the
 nearest surface point within ``tailbeam.plate.solid.surface.SURFACE_TOLERANCE`` of the
-structure's size). On the flat plate a channel reads the deflection w at (x, y) times the
-direction's z component: the scene reader only lets through points of the top (z = 0) or
-bottom (z = -thickness) surface read along +-z, where plate theory's normal displacement is
-w at both faces.
+structure's size). On the flat plate a channel at a point of its top (z = 0) or bottom
+(z = -thickness) face reads the surface's motion by Kirchhoff's kinematics: the deflection w
+along the direction's z component, and the in-plane displacement -zeta grad w (zeta the
+point's height above the mid-plane: +h/2 on top, -h/2 below) along its x, y components;
+grad w by central differences (``GRADIENT_STEP``, one-sided at an edge). On a Mindlin plate
+this reads the slope of w where the plate's own rotation differs from it by the shear angle.
 
 The static part (the full model's displacement at the channel under 1 N pressing on the
 impact face, for the truncated modes' quasi-static response) is taken by Maxwell-Betti
@@ -19,8 +21,9 @@ direction, read as the z-displacement at the load points.
 
 import numpy as np
 
-from tailbeam.errors import InputError
 from tailbeam.physics.contact_patch import disc_rule
+
+GRADIENT_STEP = 1e-5  # m: central differences of w for the flat plate's in-plane motion
 
 
 class Readings:
@@ -57,13 +60,27 @@ class Readings:
         return self.model.surface_operator(pts, dirs, fields)
 
     def _flat(self):
-        """(points (p, 2) m, z components (p,)) of the channels on the flat plate."""
+        """(points (p, 2) m, z components (p,), levers (p, 2) m) of the channels on the flat
+        plate: a channel reads z w + lever . grad w, lever = -zeta (dx, dy)."""
         pts, dirs = self._points_directions()
-        if np.any(np.abs(dirs[:, :2]) > 1e-12):
-            raise InputError(
-                "sensors", "on the flat plate a sensor reads along the normal (0, 0, +-1) only"
-            )
-        return pts[:, :2], dirs[:, 2]
+        zeta = pts[:, 2] + 0.5 * self.basis.plate.thickness
+        return pts[:, :2], dirs[:, 2], -zeta[:, None] * dirs[:, :2]
+
+    def _flat_reading(self, evaluate) -> np.ndarray:
+        """(p, k) the channels' readings of a field: ``evaluate(i, points (m, 2))`` -> (m, k)
+        its deflection at points of the plate for channel i (the same field for every
+        channel, or one per channel)."""
+        xy, zs, levers = self._flat()
+        rows = []
+        for i, (point, z, lever) in enumerate(zip(xy, zs, levers, strict=True)):
+            if not np.any(lever):
+                rows.append(z * evaluate(i, point[None, :])[0])
+                continue
+            stencil, steps = _stencil(self.basis.plate, point)
+            values = evaluate(i, np.vstack([point[None, :], stencil]))
+            slope = (values[1::2] - values[2::2]) / steps[:, None]  # d/dx, d/dy
+            rows.append(z * values[0] + lever @ slope)
+        return np.array(rows)
 
     def shapes(self) -> np.ndarray:
         """(p, n_modes) modal displacements along each channel's direction, 1/sqrt(kg)
@@ -73,15 +90,18 @@ class Readings:
             if self.model is not None:
                 self._shapes = np.asarray(self._operator() @ self.basis.mode_vectors)[:, :n]
             else:
-                pts, sign = self._flat()
-                self._shapes = self.basis.deflection(pts) * sign[:, None]
+                self._shapes = self._flat_reading(lambda _i, pts: self.basis.deflection(pts))
         return self._shapes
 
     def _static_flat(self, loads) -> np.ndarray:
-        pts, sign = self._flat()
+        """(q, p): by reciprocity, the deflection at the loads under 1 N at each channel's
+        point, read at that point as the channel reads a field."""
         loads = np.atleast_2d(np.asarray(loads, dtype=float))
-        cols = [self.basis.static_deflection_at(p, loads, 0.0) for p in pts]
-        return np.column_stack(cols) * sign[None, :]
+
+        def at(_i, pts):  # (m, q): deflection at the loads under 1 N at each of pts
+            return np.array([self.basis.static_deflection_at(p, loads, 0.0) for p in pts])
+
+        return self._flat_reading(at).T
 
     def _static_solid(self, loads) -> np.ndarray:
         if self._columns is None:  # K^-1 of a unit force at each channel along its direction
@@ -102,3 +122,18 @@ class Readings:
             full = weights @ self.static(pts)
         phibar = self.basis.load_deflection([load_point], contact_radius)[0]
         return full - self.shapes() @ (phibar / self.basis.omega**2)
+
+
+def _stencil(plate, point) -> tuple:
+    """((4, 2) points x + h, x - h, y + h, y - h about ``point``, kept on the plate, and
+    (2,) their spacings along x and y, m)."""
+    half = 0.5 * np.array([plate.size_x, plate.size_y])
+    out, steps = [], []
+    for axis in (0, 1):
+        step = np.zeros(2)
+        step[axis] = GRADIENT_STEP
+        plus = np.minimum(point + step, half)
+        minus = np.maximum(point - step, -half)
+        out += [plus, minus]
+        steps.append(plus[axis] - minus[axis])
+    return np.array(out), np.array(steps)
