@@ -10,7 +10,7 @@ structure's size). On the flat plate a channel at a point of its top (z = 0) or 
 (z = -thickness) face reads the surface's motion by Kirchhoff's kinematics: the deflection w
 along the direction's z component, and the in-plane displacement -zeta grad w (zeta the
 point's height above the mid-plane: +h/2 on top, -h/2 below) along its x, y components;
-grad w by central differences (``GRADIENT_STEP``, one-sided at an edge). On a Mindlin plate
+grad w by central differences (``tailbeam.plate.slopes``, one-sided at an edge). On a Mindlin plate
 this reads the slope of w where the plate's own rotation differs from it by the shear angle.
 
 The static part (the full model's displacement at the channel under 1 N pressing on the
@@ -22,8 +22,7 @@ direction, read as the z-displacement at the load points.
 import numpy as np
 
 from tailbeam.physics.contact_patch import disc_rule
-
-GRADIENT_STEP = 1e-5  # m: central differences of w for the flat plate's in-plane motion
+from tailbeam.plate.slopes import values_and_slopes
 
 
 class Readings:
@@ -76,10 +75,10 @@ class Readings:
             if not np.any(lever):
                 rows.append(z * evaluate(i, point[None, :])[0])
                 continue
-            stencil, steps = _stencil(self.basis.plate, point)
-            values = evaluate(i, np.vstack([point[None, :], stencil]))
-            slope = (values[1::2] - values[2::2]) / steps[:, None]  # d/dx, d/dy
-            rows.append(z * values[0] + lever @ slope)
+            plate = self.basis.plate
+            half = 0.5 * np.array([plate.size_x, plate.size_y])
+            value, slope = values_and_slopes(lambda pts, i=i: evaluate(i, pts), point, half)
+            rows.append(z * value[0] + slope[0] @ lever)
         return np.array(rows)
 
     def shapes(self) -> np.ndarray:
@@ -122,18 +121,3 @@ class Readings:
             full = weights @ self.static(pts)
         phibar = self.basis.load_deflection([load_point], contact_radius)[0]
         return full - self.shapes() @ (phibar / self.basis.omega**2)
-
-
-def _stencil(plate, point) -> tuple:
-    """((4, 2) points x + h, x - h, y + h, y - h about ``point``, kept on the plate, and
-    (2,) their spacings along x and y, m)."""
-    half = 0.5 * np.array([plate.size_x, plate.size_y])
-    out, steps = [], []
-    for axis in (0, 1):
-        step = np.zeros(2)
-        step[axis] = GRADIENT_STEP
-        plus = np.minimum(point + step, half)
-        minus = np.maximum(point - step, -half)
-        out += [plus, minus]
-        steps.append(plus[axis] - minus[axis])
-    return np.array(out), np.array(steps)

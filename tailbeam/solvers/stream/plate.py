@@ -27,9 +27,9 @@ import numpy as np
 
 from tailbeam.errors import InputError
 from tailbeam.plate.compliance import Compliance
+from tailbeam.plate.slopes import values_and_slopes
 from tailbeam.solvers.plate_loads.propagator import advance, coefficients
 
-GRADIENT_STEP = 1e-5  # m, central differences of the mode shapes (friction's lever)
 GRID = 61  # points per side where max |phi_k| is sampled
 GRID_SAFETY = 1.1  # the sampled maximum, raised for peaks between grid points
 
@@ -79,15 +79,9 @@ class StreamPlate:
 
     def gradients(self, xy) -> np.ndarray:
         """(p, m, 2) gradients d phi / d(x, y) (1/(m sqrt(kg))) of the mode shapes at points
-        xy (p, 2) m: central differences of step GRADIENT_STEP (relative error
-        ~(k GRADIENT_STEP)^2 / 6 for a mode of wavenumber k), where friction acts on the
-        plate's top surface (``active.compiled.friction``)."""
-        xy = np.reshape(np.asarray(xy, dtype=float), (-1, 2))
-        h = GRADIENT_STEP
-        offsets = np.array([[h, 0.0], [-h, 0.0], [0.0, h], [0.0, -h]])
-        values = self.shapes((xy[None, :, :] + offsets[:, None, :]).reshape(-1, 2))
-        values = values.reshape(4, xy.shape[0], self.n_modes)
-        return np.stack([values[0] - values[1], values[2] - values[3]], axis=-1) / (2.0 * h)
+        xy (p, 2) m (``tailbeam.plate.slopes``), where friction acts on the plate's top
+        surface (``active.compiled.friction``)."""
+        return values_and_slopes(self.shapes, xy)[1]
 
     def compliance(self, xy, radii) -> np.ndarray:
         """(p,) residual compliance (m/N) at points xy (p, 2) m for loads spread over discs

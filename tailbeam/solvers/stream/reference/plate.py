@@ -36,7 +36,7 @@ displacement is -(h/2) grad w (Kirchhoff): the modes feel the generalised force
 friction dissipates (F_t . slip), so with c = 0 and undamped modes energy + dissipated is
 conserved (the check).
 
-grad phi is a central difference of the basis (step ``GRADIENT_STEP``: relative error
+grad phi is a central difference of the basis (``tailbeam.plate.slopes``: relative error
 ~(k h)^2 / 6 < 1e-7 of the slope for wavenumbers k < 100 /m, itself ~1e-5 of the force).
 """
 
@@ -45,9 +45,9 @@ import math
 import numpy as np
 
 from tailbeam.errors import InputError
+from tailbeam.plate.slopes import values_and_slopes
 
 SHAPES = ("exact", "frozen")
-GRADIENT_STEP = 1e-5  # m, central differences of the mode shapes
 GRID = 41  # points per side where max |phi| is sampled (scale of the modal tolerances)
 
 
@@ -123,14 +123,9 @@ class ReferencePlate:
 
     def shapes_and_gradients(self, xy):
         """(p, m) mode shapes and (p, m, 2) their gradients d phi / d(x, y) in
-        1/(m sqrt(kg)) at points xy (p, 2) m (one evaluation of the basis at 5 p points)."""
-        xy = np.reshape(np.asarray(xy, dtype=float), (-1, 2))
-        h = GRADIENT_STEP
-        offsets = np.array([[0.0, 0.0], [h, 0.0], [-h, 0.0], [0.0, h], [0.0, -h]])
-        values = self.shapes_at((xy[None, :, :] + offsets[:, None, :]).reshape(-1, 2))
-        values = values.reshape(5, xy.shape[0], self.n_modes)
-        grad = np.stack([values[1] - values[2], values[3] - values[4]], axis=-1) / (2.0 * h)
-        return values[0], grad
+        1/(m sqrt(kg)) at points xy (p, 2) m (``tailbeam.plate.slopes``: one evaluation of
+        the basis at 5 p points)."""
+        return values_and_slopes(self.shapes_at, xy)
 
     def acceleration(self, q, qd, modal_force) -> np.ndarray:
         """q'' (m sqrt(kg) / s^2) of the modes under modal forces (N / sqrt(kg))."""
