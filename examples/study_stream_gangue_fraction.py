@@ -23,7 +23,7 @@ particles/s (known), and the rate uniform 50-150 particles/s per case (unknown, 
 then the vibration's power no longer tells the gangue fraction by itself). The numbers are
 the separability of simulated signals under this model, not a field accuracy.
 
-Quick mode (the tests run it): 6 cases of 0.6 s with 0.1-0.15 m drops, 0.2 s windows,
+Quick mode (the tests run it): 6 cases of 0.3 s with 0.1-0.15 m drops, 0.1 s windows,
 3 folds, two SNRs, the first condition. Full mode: two conditions of 100 cases of 3 s, five
 SNRs (~5 min on 2 shared cores).
 """
@@ -46,7 +46,7 @@ AXIS = "streams.cave.gangue_fraction"
 SNR_DB = (math.inf, 20.0, 10.0, 0.0, -10.0)
 QUICK_SNR_DB = (math.inf, 0.0)
 FULL = {"samples": 100, "duration": 3.0, "window": 1.0, "height": [0.3, 0.8], "folds": 5}
-QUICK = {"samples": 6, "duration": 0.6, "window": 0.2, "height": [0.1, 0.15], "folds": 3}
+QUICK = {"samples": 6, "duration": 0.3, "window": 0.1, "height": [0.1, 0.15], "folds": 3}
 
 
 def base_scene(duration: float, height: list) -> dict:

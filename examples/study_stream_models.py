@@ -12,7 +12,7 @@ grouped by case, without added noise and at SNR_DB (one noise RMS for every sens
 median clean window RMS over the three sensors). Separability of simulated signals under this
 model, not field accuracies.
 
-Quick mode (the tests run it): 6 cases of 0.6 s, 0.2 s windows, 3 folds, the forest only.
+Quick mode (the tests run it): 6 cases of 0.3 s, 0.1 s windows, 3 folds, the forest only.
 """
 
 import argparse
