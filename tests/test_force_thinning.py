@@ -47,7 +47,7 @@ def test_straight_lines_and_jumps():
 
 
 def test_thinned_replay_on_the_modal_plate():
-    """Two spinning coal balls land obliquely on the SSSS plate (modes to 1.3 kHz, friction's
+    """A spinning coal ball lands obliquely on the SSSS plate (modes to 1.3 kHz, friction's
     moment in the replay): the sensors' replay of the thinned force histories (THIN of each
     drained piece's peak, THIN_FRICTION for the friction rows) against the replay of every
     node written: the modal state within 10 THIN_FRICTION (relative to its largest value over
@@ -56,18 +56,17 @@ def test_thinned_replay_on_the_modal_plate():
     incline = InclinedPlate(Plate(), 10.0, STANDARD_GRAVITY)
     balls = [
         Ball("A", COAL, 0.02, (-0.1, 0.05, 0.021), (1.5, 0.3, -1.2), (0.0, 40.0, 0.0)),
-        Ball("B", COAL, 0.03, (0.1, -0.1, 0.0305), (-1.0, 0.0, -0.8), (20.0, 0.0, 5.0)),
     ]
     particles = [Particle.from_ball(b, default_label(b)) for b in balls]
     model = FrictionModel(FrictionSettings(0.5, 0.4, 1e-3, 2e-3, rolling=0.1))
-    times = np.linspace(0.0, 0.006, 121)
+    times = np.linspace(0.0, 0.003, 61)
     replays, nodes = [], []
     for thin in ((forces.THIN, forces.THIN_FRICTION), (0.0, 0.0)):
         with pytest.MonkeyPatch.context() as mp:
             mp.setattr(members, "THIN", thin[0])
             mp.setattr(members, "THIN_FRICTION", thin[1])
             plate = StreamPlate(basis, np.full(basis.n_modes, 0.01), residual_flexibility=False)
-            run = solve_stream(particles, incline, 0.006, damping=300.0, rtol=1e-10,
+            run = solve_stream(particles, incline, 0.003, damping=300.0, rtol=1e-10,
                                friction=model, progress=False, plate=plate)  # fmt: skip
         response = LoadResponse.from_records(basis, np.full(basis.n_modes, 0.01), run.loads,
                                              run.dead_loads, quasi_static=False)  # fmt: skip
