@@ -2,14 +2,17 @@
 moment on the modal plate changes at the sensors.
 
     python benchmarks/bench_friction_stream.py --out DIR [--quick] [--particles N]
-        [--stiction V]
+        [--stiction V] [--skip-moment]
 
 The scene is ``examples/caving_stream.toml`` (particles at 200 per second onto the 30-degree
 SSSS plate, modes to 10 kHz coupled both ways with contact tails, two 51.2 kHz sensors; the
 stream lasts n / 200 s and the simulation 1 s longer: 6 s for its 1000 particles). Each case
-runs ``tailbeam.simulate`` (the fast stream solver) in its own process after one warm-up run
-that fills the numba and basis caches; wall time is timed inside it, peak memory is the
-process's maximum resident set (numba and the basis included).
+runs ``tailbeam.simulate`` (the fast stream solver) and then the sensor signals (the modal
+plate's replay of the recorded loads) in its own process after one warm-up run that fills
+the numba and basis caches. Timed inside it: the process's CPU seconds of the run and of the
+sensor signals (the measure to compare on a shared machine) and the wall time of both; peak
+memory is the process's maximum resident set (numba and the basis included); the load
+average when the case ended is recorded beside them.
 
 Cases, on the rigid and on the modal plate: frictionless, and with ``[contact.friction]``
 static 0.5, dynamic 0.4, rolling 0.1 (coal and sandstone on steel in the DEM literature of
@@ -17,7 +20,7 @@ top-coal caving: mu 0.3-0.6), stiction velocity V (default 1e-3 m/s, the manual'
 for lumps that stop) and transition velocity 2 V. On the modal plate once more with the
 friction force's moment on the plate left out (a private switch,
 ``friction_pairs._PLATE_MOMENT``): the relative change of each sensor's in-band RMS (0-10 kHz)
-is what the moment contributes.
+is what the moment contributes (``--skip-moment``: not run).
 
 ``--quick``: 100 particles (``--particles`` sets the count). Writes DIR/table.md,
 DIR/results.json and every case's scene and results (DIR/<case>.toml, DIR/<case>.json).
@@ -25,6 +28,7 @@ DIR/results.json and every case's scene and results (DIR/<case>.toml, DIR/<case>
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -70,12 +74,19 @@ def run_case(path: str, moment: bool = True) -> dict:
 
     friction_pairs._PLATE_MOMENT = moment
     scene = load_scene(path)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     result = tailbeam.simulate(scene, solver="stream", progress=False)
-    wall = time.perf_counter() - t0
+    c1 = time.process_time()
     outputs = result.sensor_outputs or {}
+    c2, wall = time.process_time(), time.perf_counter() - t0
+    loads = getattr(result.plate, "loads", None)
     return {
         "wall_s": wall,
+        "cpu_s": c2 - c0,
+        "cpu_run_s": c1 - c0,
+        "cpu_sensors_s": c2 - c1,
+        "load_average": os.getloadavg()[0],
+        "load_nodes": None if loads is None else int(loads.n_nodes),
         "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "particles": len(result.particles),
         "contacts": len(result.impacts),
@@ -108,6 +119,8 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="100 particles")
     parser.add_argument("--particles", type=int, default=None)
     parser.add_argument("--stiction", type=float, default=1e-3, help="m/s")
+    parser.add_argument("--skip-moment", action="store_true",
+                        help="do not run the modal case without friction's moment")  # fmt: skip
     args = parser.parse_args(argv)
     n = args.particles or (100 if args.quick else 1000)
     out = args.out
@@ -118,7 +131,7 @@ def main(argv=None) -> int:
     rows, results = [], {}
     for model in ("rigid", "modal"):
         cases = [("frictionless", None, True), ("friction", args.stiction, True)]
-        if model == "modal":
+        if model == "modal" and not args.skip_moment:
             cases.append(("friction, no moment", args.stiction, False))
         for label, vs, moment in cases:
             name = f"{model}_{label.replace(', ', '_').replace(' ', '_')}"
@@ -136,15 +149,20 @@ def _table(n, stiction, rows, results) -> str:
         f"{n} particles, friction mu_s 0.5, mu_d 0.4, mu_r 0.1, v_s {stiction:g} m/s, "
         f"v_d {2 * stiction:g} m/s",
         "",
-        "| plate | case | wall s | x frictionless | peak MB | contacts | kernel steps |",
-        "|---|---|---|---|---|---|---|",
+        "| plate | case | CPU s: run + sensors | x frictionless (CPU) | wall s | load average "
+        "| peak MB | contacts | kernel steps | load nodes |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for model, label, r in rows:
-        base = results[f"{model}_frictionless"]["wall_s"]
+        base = results[f"{model}_frictionless"]["cpu_s"]
         lines.append(
-            f"| {model} | {label} | {r['wall_s']:.1f} | {r['wall_s'] / base:.2f} | "
-            f"{r['peak_rss_mb']:.0f} | {r['contacts']} | {r['kernel_steps']} |"
+            f"| {model} | {label} | {r['cpu_run_s']:.1f} + {r['cpu_sensors_s']:.1f} | "
+            f"{r['cpu_s'] / base:.2f} | {r['wall_s']:.1f} | {r['load_average']:.1f} | "
+            f"{r['peak_rss_mb']:.0f} | {r['contacts']} | {r['kernel_steps']} | "
+            f"{r['load_nodes'] if r['load_nodes'] is not None else '-'} |"
         )
+    if "modal_friction_no_moment" not in results:
+        return "\n".join(lines) + "\n"
     with_m = results["modal_friction"]["sensor_rms_in_band"]
     without = results["modal_friction_no_moment"]["sensor_rms_in_band"]
     lines += [

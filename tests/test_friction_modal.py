@@ -149,7 +149,7 @@ def test_ten_balls_on_the_modal_plate_as_the_reference(ten, basis):
     tests/test_friction_fast.py; measured 1e-10, the tangential impulses 8e-8), friction's
     dissipated energy and the plate's modal state at the end within 1e-6 (measured 8e-9,
     2e-9), and the sensors' load replay (contact forces and friction's couples) gives the
-    same modal state within 1e-6 (measured 1.4e-8)."""
+    same modal state within 1e-6 (measured 1.9e-8, the histories thinned)."""
     fast, plate, ref = ten
     balls = ten_balls()
     landings = [r.ball for r in fast.contacts if r.partner == "plate"]

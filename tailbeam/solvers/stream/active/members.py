@@ -23,7 +23,7 @@ from tailbeam.results.records import EventCode
 from tailbeam.solvers.stream.active import friction_pairs
 from tailbeam.solvers.stream.active.carry import CarriedRows
 from tailbeam.solvers.stream.active.compiled.pairs import first_contact_step
-from tailbeam.solvers.stream.active.forces import PlateForces
+from tailbeam.solvers.stream.active.forces import THIN, THIN_FRICTION, PlateForces
 from tailbeam.solvers.stream.active.plate_pairs import PlatePairs
 from tailbeam.solvers.stream.active.rest import excess_energy, place_at_rest, static_height
 from tailbeam.solvers.stream.active.set import ActiveSet
@@ -72,7 +72,8 @@ class ActiveMembers:
         self.plate = plate
         self.settle_energy = settle_energy
         self.modal = None if plate is None else PlatePairs(plate, balls, rtol, dead_loads)
-        self.forces = PlateForces(self._friction_lever())
+        thin = (0.0, 0.0) if friction is None else (THIN, THIN_FRICTION)
+        self.forces = PlateForces(self._friction_lever(), thin)
         self.carried = CarriedRows()
         self.now = 0.0
         self.members, self.quiet = [], set()  # quiet: members resting on the plate
