@@ -125,14 +125,29 @@ def modes_figure(mesh, out: Path, count: int = 6) -> Path:
     return path
 
 
+def _nice(value: float) -> float:
+    """The smallest of 1, 2, 4, 5 or 8 times a power of ten at or above ``value`` (> 0)."""
+    power = 10.0 ** np.floor(np.log10(max(value, 1e-30)))
+    return float(next(m * power for m in (1, 2, 4, 5, 8, 10) if m * power >= value))
+
+
 def _collection(path: Path):
     sets = ET.parse(path).getroot().find("Collection").findall("DataSet")
     return [(float(d.get("timestep")), d.get("file")) for d in sets]
 
 
-def frame_figure(folder: Path, time: float, out: Path) -> Path:
+def to_plate(points, inclination_deg: float) -> np.ndarray:
+    """World-frame points (p, 3) of the series back in the plate frame (tailbeam.io.paraview:
+    x_world = R x_plate, R's columns the plate's axes)."""
+    t = np.radians(inclination_deg)
+    rot = np.array([[np.cos(t), 0.0, np.sin(t)], [0.0, 1.0, 0.0], [-np.sin(t), 0.0, np.cos(t)]])
+    return np.asarray(points) @ rot
+
+
+def frame_figure(folder: Path, time: float, out: Path, inclination: float = 30.0) -> Path:
     """The particles and the impact face's deflection at the last frame at or before
-    ``time``, seen along the face's normal (the plate frame's x-y)."""
+    ``time``, seen along the face's normal (the plate frame's x-y); particles more than
+    5 mm above the face (in flight) drawn hollow."""
     import matplotlib.pyplot as plt
     import meshio
     from matplotlib.collections import PatchCollection
@@ -148,32 +163,37 @@ def frame_figure(folder: Path, time: float, out: Path) -> Path:
     structure = next((v for k, v in chosen.items() if "particle" not in k), None)
     if structure is not None:
         mesh = meshio.read(folder / structure[1])
-        pts = mesh.points
-        field = next(iter(k for k in mesh.point_data if "deflection" in k or "displacement" in k))
-        data = np.asarray(mesh.point_data[field])
-        w = data[:, 2] if data.ndim == 2 else data
-        top = np.isclose(pts[:, 2], pts[:, 2].max(), atol=1e-6)
+        pts = to_plate(mesh.points, inclination)
+        w = np.asarray(mesh.point_data["deflection"])
+        top = np.abs(pts[:, 2]) < 1e-6
         tri = Triangulation(pts[top, 0], pts[top, 1])
-        lim = max(np.max(np.abs(w[top])), 1e-15) * 1e6
+        lim = _nice(np.max(np.abs(w[top])) * 1e6)
         cs = ax.tricontourf(tri, w[top] * 1e6, levels=np.linspace(-lim, lim, 21), cmap="RdBu_r")
-        fig.colorbar(cs, ax=ax, label="impact face deflection (um)")
+        fig.colorbar(cs, ax=ax, label="impact face deflection (um, + up)",
+                     ticks=np.linspace(-lim, lim, 9))  # fmt: skip
     particles = next((v for k, v in chosen.items() if "particle" in k), None)
     if particles is not None:
         mesh = meshio.read(folder / particles[1])
-        radius = mesh.point_data.get("radius")
-        label = mesh.point_data.get("label", np.zeros(len(mesh.points)))
-        discs = [Circle((x, y), r) for (x, y, _), r in zip(mesh.points, radius, strict=True)]
-        colours = ["tab:orange" if v else "0.2" for v in np.ravel(label)]
-        ax.add_collection(PatchCollection(discs, facecolors=colours, edgecolors="k",
-                                          linewidths=0.3, alpha=0.8))  # fmt: skip
+        pts = to_plate(mesh.points, inclination)
+        radius = np.ravel(mesh.point_data["radius"])
+        label = np.ravel(mesh.point_data["label"])
+        flying = pts[:, 2] - radius > 5e-3
+        for group, face in ((flying, "none"), (~flying, None)):
+            discs = [Circle((x, y), r) for (x, y, _), r in zip(pts[group], radius[group],
+                                                                  strict=True)]  # fmt: skip
+            colours = ["tab:orange" if v else "0.2" for v in label[group]]
+            ax.add_collection(PatchCollection(
+                discs, facecolors=face or colours, edgecolors=colours, linewidths=0.8,
+                alpha=0.85))  # fmt: skip
     ax.set_aspect("equal")
     ax.set_xlim(-0.9, 0.9)
     ax.set_ylim(-0.75, 0.75)
     ax.set_xlabel("x (m, downhill; hinge at -0.9)")
     ax.set_ylabel("y (m)")
     t = structure[0] if structure else particles[0]
-    ax.set_title(f"the caving stream on the example beam at t = {t:.2f} s (coal dark, gangue "
-                 "orange; discs drawn at the lumps' radii, plate frame)", fontsize=9)  # fmt: skip
+    ax.set_title(f"The caving stream on the example beam at t = {t:.2f} s, seen along the "
+                 "face's normal\n(coal dark, gangue orange, at their radii; hollow: in flight)",
+                 fontsize=10)  # fmt: skip
     fig.tight_layout()
     path = out / "beam-frame.png"
     fig.savefig(path, dpi=110)
@@ -188,7 +208,7 @@ def sensors_figure(beam: Path, flat: Path, out: Path, beam_channel="back", flat_
         data = np.genfromtxt(folder / "sensors.csv", delimiter=",", names=True)
         return data["t"], data[channel]
 
-    fig, axes = plt.subplots(2, 1, figsize=(10, 5.6), sharex=True, sharey=True)
+    fig, axes = plt.subplots(2, 1, figsize=(10, 5.6), sharex=True)
     for ax, (folder, channel, what) in zip(axes, [
         (beam, beam_channel, f"beam, back sensor '{beam_channel}' (bottom plate, x = 0.45 m)"),
         (flat, flat_channel, f"flat 0.6 x 0.6 x 0.01 m SSSS plate, sensor '{flat_channel}'"),
@@ -196,10 +216,12 @@ def sensors_figure(beam: Path, flat: Path, out: Path, beam_channel="back", flat_
         t, a = read(folder, channel)
         ax.plot(t, a, lw=0.4)
         ax.set_ylabel("acceleration (m/s^2)")
-        ax.set_title(what, fontsize=10)
+        rms = np.sqrt(np.mean(a**2))
+        ax.set_title(f"{what}: peak {np.max(np.abs(a)):.3g}, RMS {rms:.3g} m/s^2 "
+                     "(own scale)", fontsize=10)  # fmt: skip
     axes[-1].set_xlabel("t (s)")
-    fig.suptitle("The same caving stream (1000 lumps, 200 per second), modes to 2 kHz",
-                 fontsize=11)  # fmt: skip
+    fig.suptitle("The same caving stream (200 lumps per second, radii 10-40 mm), modes to 2 kHz, "
+                 "sensors through their chain", fontsize=11)  # fmt: skip
     fig.tight_layout()
     path = out / "beam-sensor.png"
     fig.savefig(path, dpi=110)
@@ -220,6 +242,7 @@ def main(argv=None) -> int:
     b = sub.add_parser("frame")
     b.add_argument("folder", type=Path)
     b.add_argument("--time", type=float, default=2.0)
+    b.add_argument("--inclination", type=float, default=30.0, help="degrees (the scene's)")
     c = sub.add_parser("sensors")
     c.add_argument("beam", type=Path)
     c.add_argument("flat", type=Path)
@@ -231,7 +254,7 @@ def main(argv=None) -> int:
         mesh = meshio.read(args.vtu)
         print(mesh_figure(mesh, args.out), modes_figure(mesh, args.out))
     elif args.what == "frame":
-        print(frame_figure(args.folder, args.time, args.out))
+        print(frame_figure(args.folder, args.time, args.out, args.inclination))
     else:
         print(sensors_figure(args.beam, args.flat, args.out))
     return 0
