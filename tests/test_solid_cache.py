@@ -2,8 +2,8 @@
 a cached basis equals the freshly solved one bit for bit (and the solver is not run again),
 every field of the key misses when changed (a spring's stiffness, one mesh node, the face,
 the material, the band, a hinge axis), the key ignores the mesh file's path and time, a
-damaged file is recomputed with a one-line note, and the static compliances read back equal
-the model's own factorised solve."""
+damaged file is recomputed with a one-line note, and the static compliances (the face
+compliance matrix) read back equal the ones first computed, without solving again."""
 
 import os
 import shutil
@@ -14,6 +14,7 @@ from solid_meshes import box_mesh
 
 from tailbeam.physics.materials import CARBON_STEEL, Material
 from tailbeam.plate.solid import Support, assemble_structure, structure_modes
+from tailbeam.plate.solid import cached as solid_cached
 from tailbeam.plate.solid import modes as solid_modes
 from tailbeam.plate.solid.cached import basis_key, static_key
 
@@ -138,18 +139,25 @@ def test_static_compliances_read_back(mesh, tmp_path, monkeypatch):
     model = assemble_structure(mesh, "top", SUPPORTS)
     direct = model.static_compliance(pts, 0.004)  # the factorised solve
     basis = structure_modes(model, fmax_hz=FMAX, cache_dir=tmp_path)
-    assert np.array_equal(basis.static_compliance_at(pts, 0.004), direct)
+    first = basis.static_compliance_at(pts, 0.004)
+    # 6.8e-7 measured: round-off on a plate on a soft (2e6 N/m) spring, where the face
+    # compliance and the direct solve differ most (tests/test_solid_face_readings.py)
+    np.testing.assert_allclose(first, direct, rtol=1e-6)
     fresh_model = assemble_structure(mesh, "top", SUPPORTS)
 
     def no_solve(*args, **kwargs):
         raise AssertionError("the static compliance was solved again")
 
-    monkeypatch.setattr(fresh_model, "static_compliance", no_solve)
+    monkeypatch.setattr(solid_cached, "face_green", no_solve)
     again = structure_modes(fresh_model, fmax_hz=FMAX, cache_dir=tmp_path)
     assert again.info["cache"] == "hit"
-    assert np.array_equal(again.static_compliance_at(pts[::-1], 0.004), direct[::-1])
-    with pytest.raises(AssertionError, match="solved again"):  # a new radius is solved
-        again.static_compliance_at(pts, 0.005)
+    assert np.array_equal(again.static_compliance_at(pts[::-1], 0.004), first[::-1])
+    other = basis.static_compliance_at(pts, 0.005)  # a new radius: from the file, no solve
+    assert np.array_equal(again.static_compliance_at(pts, 0.005), other)
+    nowhere = structure_modes(assemble_structure(mesh, "top", SUPPORTS), fmax_hz=FMAX,
+                              cache_dir=tmp_path / "empty")  # fmt: skip
+    with pytest.raises(AssertionError, match="solved again"):  # no file: it is solved
+        nowhere.static_compliance_at(pts, 0.004)
 
 
 SCENE = f"""duration = 0.001

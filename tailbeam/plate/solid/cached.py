@@ -9,25 +9,26 @@ version. Any change gives another file, so a stale basis is never reused; the ke
 stored in the file and checked on load. A damaged file is recomputed and overwritten, with
 a note.
 
-The static compliances under contact discs (the residual flexibility's K^-1, which needs a
-factorisation of K, tens of seconds on the example beam) are kept beside the basis, one file
-per structure (``static_key``: the same key without the band), point by point as runs ask
-for them (``StaticCompliances``).
+The static compliances under contact discs (the residual flexibility's K^-1) come from the
+impact face's compliance matrix (``tailbeam.plate.solid.face_compliance``: minutes of solves
+on the example beam), kept beside the basis, one file per structure (``static_key``: the
+same key without the band; ``StaticCompliances``).
 """
 
 import dataclasses
-import weakref
 from pathlib import Path
 
 import numpy as np
 
 from tailbeam.plate import cache as disk
+from tailbeam.plate.solid.face_compliance import FaceCompliance, face_dofs, face_green
+from tailbeam.plate.solid.face_readings import model_readings
 from tailbeam.plate.solid.model import StructureModel
 from tailbeam.progress import note
 
 BASIS_PREFIX = "structure"
-STATIC_PREFIX = "structure-static"
-ROUND = 12  # decimals (m) of a point's and a radius' key in the static compliances
+STATIC_PREFIX = "structure-face-compliance"
+ROUND = 12  # decimals (m) of a point's and a radius' key in the direct solves' memo
 
 
 def _model_meta(model: StructureModel) -> dict:
@@ -93,62 +94,58 @@ def store_basis(path: Path, key: str, freqs, phi, info: dict) -> None:
 
 
 class StaticCompliances:
-    """``model.static_compliance`` through a per-structure file of the values already
-    computed (points and disc radii rounded to ``ROUND`` decimals of a metre); new values
-    are computed by the model (its factorisation, made on first need). The file is rewritten
-    atomically, merged with what another run wrote, after the first new value and then
-    whenever the new values reach the number saved (a stream's thousands of contact points
-    cost O(n) writes), and at exit. ``cache_dir`` None: no file, the model's values."""
+    """``model.static_compliance`` on the impact face (1 N spread over a disc): through the
+    face's compliance matrix (``tailbeam.plate.solid.face_compliance``: K^-1 on the face's
+    DOFs, the direct solve's value for any point and radius), made on the first call with
+    the model's factorisation and kept in a per-structure file (``static_key``) that later
+    runs read. ``cache_dir`` None: no file. A face whose facets are not parallelograms has
+    no fast readings: each point is then solved directly and kept in memory."""
 
     def __init__(self, model: StructureModel, cache_dir=None):
         self.model = model
-        self.values = {}
-        self.unsaved = [0]  # new values not yet in the file (a list: the exit hook reads it)
-        self.path = self.key = None
-        if cache_dir is not None:
-            self.key = static_key(model)
-            self.path = disk.entry_path(cache_dir, STATIC_PREFIX, self.key)
-            self.values.update(_read_static(self.path, self.key))
-            weakref.finalize(self, _flush, self.path, self.key, self.values, self.unsaved)
+        self.cache_dir = cache_dir
+        self._face = None  # the FaceCompliance, made on first need
+        self._values = {}  # the direct solves' values, without fast readings
 
     def __call__(self, points, contact_radius: float = 0.0) -> np.ndarray:
         """(p,) mean z-deflection (m/N) over the disc under 1 N spread over it."""
+        readings = model_readings(self.model)
+        if readings is None:
+            return self._direct(points, contact_radius)
+        if self._face is None:
+            self._face = self._load_or_make(readings)
+        return self._face(points, contact_radius)
+
+    def _load_or_make(self, readings) -> FaceCompliance:
+        dofs = face_dofs(readings)
+        path = key = None
+        if self.cache_dir is not None:
+            key = static_key(self.model)
+            path = disk.entry_path(self.cache_dir, STATIC_PREFIX, key)
+            status, found = disk.read_entry(path, key)
+            if status == "hit" and np.array_equal(found.get("dofs"), dofs):
+                return FaceCompliance(self.model, readings, dofs, found["green"])
+            if status != "missing":
+                why = found if status == "damaged" else "its DOFs do not fit the structure"
+                note(f"static compliance cache: {path} is damaged ({why}); recomputing it")
+        green = face_green(self.model, dofs)
+        if path is not None:
+            try:
+                disk.write_entry(path, key, {"dofs": dofs, "green": green},
+                                 {"what": "K^-1 on the impact face's DOFs, m/N"})  # fmt: skip
+            except OSError:
+                pass  # an unwritable cache: the matrix stays in memory for this run
+        return FaceCompliance(self.model, readings, dofs, green)
+
+    def _direct(self, points, contact_radius):
         pts = np.atleast_2d(np.asarray(points, dtype=float))
         keys = [(round(float(x), ROUND), round(float(y), ROUND),
                  round(float(contact_radius), ROUND)) for x, y in pts]  # fmt: skip
-        todo = [i for i, k in enumerate(keys) if k not in self.values]
+        todo = [i for i, k in enumerate(keys) if k not in self._values]
         if todo:
             fresh = self.model.static_compliance(pts[todo], contact_radius)
-            self.values.update({keys[i]: float(v) for i, v in zip(todo, fresh, strict=True)})
-            self.unsaved[0] += len(todo)
-            if self.path is not None and self.unsaved[0] >= max(1, len(self.values) // 2):
-                _flush(self.path, self.key, self.values, self.unsaved)
-        return np.array([self.values[k] for k in keys])
-
-
-def _read_static(path: Path, key: str) -> dict:
-    status, found = disk.read_entry(path, key)
-    if status == "damaged":
-        note(f"static compliance cache: {path} is damaged ({found}); recomputing it")
-    if status != "hit":
-        return {}
-    return {tuple(k): float(v) for k, v in zip(found["points"], found["values"], strict=True)}
-
-
-def _flush(path: Path, key: str, values: dict, unsaved: list) -> None:
-    """Merge ``values`` (updated in place) with the file's and write them when ``unsaved[0]``
-    new ones are not in it yet (unwritable: kept in memory only)."""
-    if not unsaved[0]:
-        return
-    unsaved[0] = 0
-    for k, v in _read_static(path, key).items():
-        values.setdefault(k, v)
-    arrays = {"points": np.array(list(values), dtype=float).reshape(-1, 3),
-              "values": np.array(list(values.values()), dtype=float)}  # fmt: skip
-    try:
-        disk.write_entry(path, key, arrays, {"what": "static compliance m/N"})
-    except OSError:
-        pass  # an unwritable cache: the values stay in memory for this run
+            self._values.update({keys[i]: float(v) for i, v in zip(todo, fresh, strict=True)})
+        return np.array([self._values[k] for k in keys])
 
 
 __all__ = ["StaticCompliances", "basis_key", "basis_path", "load_basis", "static_key",

@@ -26,8 +26,10 @@ tail's wider band.
 import numpy as np
 
 from tailbeam.errors import InputError
+from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.compliance import Compliance
 from tailbeam.plate.slopes import values_and_slopes
+from tailbeam.plate.solid.face_readings import model_readings
 from tailbeam.solvers.plate_loads.propagator import advance, coefficients
 
 GRID = 61  # points per side where max |phi_k| is sampled
@@ -51,6 +53,7 @@ class StreamPlate:
         self.tail = tail  # a contact_tail.ContactTail, or None (the static spring alone)
         self.residual_flexibility = bool(residual_flexibility)
         self._compliance = Compliance(basis, self.residual_flexibility)
+        self._face = _face_modes(basis)  # a structure's fast face readings, or None
         self.omega = np.ascontiguousarray(basis.omega, dtype=float)
         self.zeta = np.ascontiguousarray(zeta, dtype=float)
         n = self.omega.shape[0]
@@ -62,7 +65,7 @@ class StreamPlate:
         xs = np.linspace(-0.5 * plate.size_x, 0.5 * plate.size_x, GRID)
         ys = np.linspace(-0.5 * plate.size_y, 0.5 * plate.size_y, GRID)
         grid = np.array([(x, y) for x in xs for y in ys])
-        self.phi_max = GRID_SAFETY * np.max(np.abs(basis.deflection(grid)), axis=0)
+        self.phi_max = GRID_SAFETY * np.max(np.abs(self.shapes(grid)), axis=0)
 
     def reset(self) -> None:
         """The plate at rest at t = 0 (before a run)."""
@@ -75,6 +78,8 @@ class StreamPlate:
 
     def shapes(self, xy) -> np.ndarray:
         """(p, m) mode shapes (1/sqrt(kg)) at points xy (p, 2) m: point loads."""
+        if self._face is not None:
+            return self._face(np.atleast_2d(np.asarray(xy, dtype=float)))
         return np.ascontiguousarray(self.basis.deflection(np.atleast_2d(xy)), dtype=float)
 
     def gradients(self, xy) -> np.ndarray:
@@ -88,8 +93,20 @@ class StreamPlate:
         of ``radii`` (p,) m (``tailbeam.physics.contact_patch.load_radius``; 0: a point load); all 0
         when residual flexibility is off."""
         xy = np.atleast_2d(np.asarray(xy, dtype=float))
+        if self._face is not None and self.residual_flexibility:
+            return np.array([self._structure_residual(p, float(r))
+                             for p, r in zip(xy, np.ravel(radii), strict=True)])  # fmt: skip
         return np.array([self._compliance(float(x), float(y), float(r))
                          for (x, y), r in zip(xy, np.ravel(radii), strict=True)])  # fmt: skip
+
+    def _structure_residual(self, xy, radius: float) -> float:
+        """``ModalBasis.residual_compliance`` of a structure at one point through its fast
+        face readings: the face compliance (``tailbeam.plate.solid.face_compliance``) minus
+        the kept modes' part over the same disc."""
+        pts, weights = disc_rule(self.basis.plate, xy, radius)
+        full = float(self.basis.static_compliance_at([xy], radius)[0])
+        phibar = weights @ self.shapes(pts)
+        return max(full - float(np.sum(phibar**2 / self.omega**2)), 0.0)
 
     def tail_at(self, xy, radius: float):
         """The dynamic tail (``contact_tail.TailModes``) of a contact at xy (2,) m with load
@@ -128,3 +145,16 @@ class StreamPlate:
     def energy(self) -> float:
         """Modal kinetic + strain energy (J) minus the dead loads' work potential."""
         return float(0.5 * np.sum(self.qd**2 + (self.omega * self.q) ** 2) - self.f_dead @ self.q)
+
+
+def _face_modes(basis):
+    """The mode shapes on a structure's impact face through its fast readings
+    (``tailbeam.plate.solid.face_readings``), or None (a flat plate's basis, or a face the
+    fast readings do not cover: the basis' own ``deflection``)."""
+    model, vectors = getattr(basis, "model", None), getattr(basis, "mode_vectors", None)
+    if model is None or vectors is None:
+        return None
+    readings = model_readings(model)
+    if readings is None:
+        return None
+    return readings.modal(np.asarray(vectors)[:, : basis.n_modes])
