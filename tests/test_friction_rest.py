@@ -11,6 +11,7 @@ frozen: slip plus rolling, each below v_s, for SLEEP_DWELL plus one refresh inte
 """
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -45,9 +46,14 @@ def ball(name, x, theta=0.0, velocity=(0.0, 0.0, 0.0), spin=(0.0, 0.0, 0.0), z=N
     return Ball(name, COAL, R, (x, 0.0, z), velocity, spin)
 
 
-def run(balls, theta, duration, *, rolling, static=0.5, sleep=True, frames=(), damping=300.0):
+def run(balls, theta, duration, *, rolling, static=0.5, sleep=True, frames=(), damping=300.0,
+        release=None):  # fmt: skip
+    """Simulate ``balls`` on the plate inclined ``theta`` degrees; ``release``: name -> its
+    release time (s; default 0)."""
     model = FrictionModel(FrictionSettings(static, 0.4, V_S, 2 * V_S, rolling))
     particles = [Particle.from_ball(b, default_label(b)) for b in balls]
+    times = release or {}
+    particles = [replace(p, t_release=times.get(p.name, p.t_release)) for p in particles]
     return solve_stream(particles, InclinedPlate(Plate(), theta, G), duration, damping=damping,
                         rtol=1e-10, friction=model, progress=False, sleep=sleep,
                         frames=frames)  # fmt: skip
@@ -178,3 +184,21 @@ def test_struck_sleeper_wakes_as_if_it_never_slept():
     assert np.allclose(p, p_ref, rtol=0, atol=1e-6 * m * v0)
     for n in "ab":
         assert np.allclose(r.final[n][0], ref.final[n][0], rtol=0, atol=1e-6 * R)
+
+
+def test_resting_lump_does_not_wake_its_frozen_neighbour():
+    """Ball a is frozen; ball b is set down at rest 1 mm beside it (slow for 20 ms before it
+    is frozen too) while ball c rolls at 1 m/s 0.2 m away. b can reach a within the set's
+    horizon only with c's energy (1.3 mm in 1 ms), which no contact can bring to it before
+    the set's next event: a is not woken. The full integration is the truth that a and b
+    never touch."""
+    gap, v0 = 1e-3, 1.0
+    c = Ball("c", COAL, R, (-0.25, 0.2, R - static_pen(0.0)), (v0, 0.0, 0.0), (0.0, v0 / R, 0.0))
+    balls = [ball("a", 0.0), ball("b", 2 * R + gap), c]
+    late = {"b": 0.03}
+    r = run(balls, 0.0, 0.12, rolling=0.2, release=late)
+    free = run(balls, 0.0, 0.12, rolling=0.2, release=late, sleep=False)
+    assert r.stats["sleeps"] >= 2 and r.stats.get("wakes", 0) == 0
+    assert np.array_equal(r.final["a"][1], np.zeros(3))
+    assert not [k for k in free.contacts if k.partner in "ab" and k.ball in "ab"]
+    assert 0.0 <= ledger_gap(r)

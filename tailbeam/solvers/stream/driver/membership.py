@@ -153,10 +153,13 @@ class Membership:
         xc = self.act.positions(core)
         # energy a core ball can receive: the core's kinetic and elastic energy, plus what
         # gravity can give in h (a drop of REACH_DROP of every core ball: far more than they
-        # fall)
+        # fall); with sleeping lumps pooled per touching cluster (``Sleepers.speed_bounds``)
         g = np.linalg.norm(b.g)
-        energy = self.act.energy(core) + np.sum(b.mass[core]) * g * REACH_DROP
-        sc = np.sqrt(2.0 * energy / b.mass[core]) + g * h
+        if self.sleepers is not None:
+            sc = self.sleepers.speed_bounds(core, REACH_DROP, h)
+        else:
+            energy = self.act.energy(core) + np.sum(b.mass[core]) * g * REACH_DROP
+            sc = np.sqrt(2.0 * energy / b.mass[core]) + g * h
         if not len(cand):
             return None
         x, _ = b.states(cand, t)

@@ -186,6 +186,39 @@ class Sleepers:
         self.clock.count("sleeps")
         self.clock.count("balls_put_to_sleep", len(comp))
 
+    # --- reach ---------------------------------------------------------------------------------
+    def speed_bounds(self, core, drop: float, h: float) -> np.ndarray:
+        """Speed bounds (m/s, one per ball of ``core``) over the next ``h`` s: the kinetic
+        energy (rotation included) and contacts' elastic energy of the ball's touching
+        cluster, plus a drop of ``drop`` m of each of its balls, all given to the ball; and
+        g h. Until the active set's next event (where this is computed again) its touching
+        pairs stay as they are, so energy moves only within a touching cluster: a resting
+        lump far from the moving ones wakes none of its sleeping neighbours."""
+        act, b = self.act, self.balls
+        g = float(np.linalg.norm(b.g))
+        root = {}
+
+        def find(i):
+            while root.get(i, i) != i:
+                i = root[i]
+            return i
+
+        for i, j in act.touching_keys():
+            if j >= 0 and find(i) != find(j):
+                root[find(i)] = find(j)
+        members = {int(i) for i in core} | set(root)
+        energy, mass = {}, {}
+        for i in members:
+            _, v = act.state(i)
+            w = act.spin(i)
+            e = 0.5 * b.mass[i] * float(v @ v) + 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
+            e += act.elastic_energy_of(i)  # (half of each ball-ball pair: both are here)
+            r = find(i)
+            energy[r] = energy.get(r, 0.0) + e
+            mass[r] = mass.get(r, 0.0) + b.mass[i]
+        pooled = np.array([energy[find(int(i))] + mass[find(int(i))] * g * drop for i in core])
+        return np.sqrt(2.0 * pooled / b.mass[np.asarray(core)]) + g * h
+
     # --- waking -------------------------------------------------------------------------------
     def wake(self, i: int, make_core) -> list:
         """Sleeping ball i is about to be touched: its cluster rejoins the active set at rest,
