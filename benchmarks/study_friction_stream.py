@@ -392,7 +392,7 @@ def plot_lumps(path, runs, duration):
         plt.Line2D([], [], color=COLOURS["gangue"], lw=0.5, label="sandstone"),
         plt.Line2D([], [], color="0.3", lw=1.8, label="touching the plate"),
         plt.Line2D([], [], color="0.3", ls="none", marker=".", label="plate impact"),
-        plt.Line2D([], [], color="tab:blue", lw=3.0, label="asleep (frozen at rest)"),
+        plt.Line2D([], [], color="tab:blue", lw=2.2, label="asleep (frozen at rest)"),
         plt.Line2D(
             [],
             [],
@@ -427,7 +427,7 @@ def _lump_panel(ax, d):
         ax.plot(d["impact_t"][mine], d["impact_x"][mine], ".", ms=3.0, color=colour)
         asleep = on[:, i] & (speed[:, i] == 0.0)
         if asleep.any():
-            ax.plot(t, np.where(asleep, x, np.nan), color="tab:blue", lw=3.0, alpha=0.8)
+            ax.plot(t, np.where(asleep, x, np.nan), color="tab:blue", lw=2.2, alpha=0.8)
         slow = on[:, i] & (speed[:, i] > 0.0) & (speed[:, i] < REST_SPEED)
         if slow.any():
             ax.plot(t[slow], pos[slow, i, 0], "o", ms=3.0, mfc="none", color="tab:purple",
@@ -435,6 +435,12 @@ def _lump_panel(ax, d):
     for edge in (-0.3, 0.3):
         ax.axhline(edge, color="0.5", lw=0.6, ls="--")
     ax.grid(alpha=0.3)
+
+
+def _num(row, key) -> float:
+    """A table cell as a float (nan where a case has none: no sensor replay)."""
+    value = row.get(key)
+    return math.nan if value in (None, "") else float(value)
 
 
 def plot_stats(path, rows):
@@ -457,16 +463,16 @@ def plot_stats(path, rows):
     fig, axes = plt.subplots(1, len(panels), figsize=(3.3 * len(panels), 4.0))
     x = np.arange(len(rows))
     for ax, (key, label) in zip(axes, panels, strict=True):
-        ax.bar(x, [float(r[key]) for r in rows], color=colour, width=0.6)
+        ax.bar(x, [_num(r, key) for r in rows], color=colour, width=0.6)
         if key == "on_beam_end":
-            ax.plot(x, [float(r["at_rest_end"]) for r in rows], "o", mfc="none", color="k",
+            ax.plot(x, [_num(r, "at_rest_end") for r in rows], "o", mfc="none", color="k",
                     ms=9, label="< 1 cm/s")  # fmt: skip
             if "asleep_end" in rows[0]:
-                ax.plot(x, [float(r["asleep_end"]) for r in rows], "o", color="tab:blue", ms=4,
+                ax.plot(x, [_num(r, "asleep_end") for r in rows], "o", color="tab:blue", ms=4,
                         label="asleep")  # fmt: skip
             ax.legend(fontsize=7, loc="upper left", framealpha=0.9)
         if key == "auc_peak_force" and "auc_S1_window_rms" in rows[0]:
-            ax.plot(x, [float(r["auc_S1_window_rms"]) for r in rows], "o", color="tab:red",
+            ax.plot(x, [_num(r, "auc_S1_window_rms") for r in rows], "o", color="tab:red",
                     label="S1 RMS, 20 ms after it")  # fmt: skip
             ax.axhline(0.5, color="0.4", lw=0.8, ls="--")
             ax.set_ylim(0.0, 1.0)
@@ -563,7 +569,8 @@ def main(argv=None):
     plot_stats(args.out / "friction-stream-stats.png", rows)
     if any("signal_S1_a" in d for _, d in runs):
         plot_spectrum(args.out / "friction-stream-spectrum.png", runs)
-    print((args.out / "table.md").read_text())
+    if (args.out / "table.md").exists():
+        print((args.out / "table.md").read_text())
 
 
 if __name__ == "__main__":
