@@ -12,7 +12,10 @@ frictionless and with friction on every contact:
 * ``mu=0.7 mu_r=0.7``: rolling resistance above tan 30 deg, standing in for lumps far from
   round: a single rolling lump decelerates on the beam;
 * ``low drop, frictionless`` and ``low drop, mu=0.7 mu_r=0.7``: the same stream released
-  20-100 mm above the plate, where lumps land slowly enough to roll and stop on the beam.
+  20-100 mm above the plate, where lumps land slowly enough to roll and stop on the beam;
+* ``low drop, mu=0.7 mu_r=0.7 d=0.01mm``: the same with the IMPACT law's penetration d
+  = 0.01 mm (else 0.1 mm), so that its damping acts on the small hops of lumps on the beam
+  (with d = 0.1 mm the restitution of a hop tends to 1 and lumps hop on for seconds).
 
 Stiction velocity 1e-3 m/s, transition velocity 2e-3 m/s (friction.md: creep below 1 mm/s).
 
@@ -25,7 +28,10 @@ forces only). Per case:
 * residence time on the beam: from a lump's first plate contact to its leaving over an edge
   (lumps still on the beam at the end are counted apart);
 * plate contact records per lump that touched the beam;
-* lumps on the beam at the end, and how many of them are at rest (centre speed < 1 cm/s);
+* lumps on the beam at the end, how many of them are at rest (centre speed < 1 cm/s) and
+  how many asleep (frozen by the fast solver's rest rule, docs/friction.md "Rest and heaps":
+  velocity exactly zero), and the lumps frozen at some time (a contact record ending
+  ``rest``);
 * in-band RMS of each sensor over the run and its Welch spectrum;
 * how much of the coal / gangue difference survives: the area under the ROC curve (AUC, 0.5 =
   no difference, 1 = separable) of gangue against coal for the peak force of each lump's
@@ -36,10 +42,12 @@ Writes ``table.md``, ``cases.csv``, ``lumps_CASE.csv`` and the figures
 ``friction-stream-lumps.png``, ``friction-stream-stats.png``, ``friction-stream-spectrum.png``
 into --out.
 
-    python benchmarks/study_friction_stream.py --out DIR [--quick] [--no-sensors]
+    python benchmarks/study_friction_stream.py --out DIR [--quick] [--stop S --duration S]
+        [--no-sensors] [--cases NAME ...] [--replot]
 
 --quick: ~100 lumps released over 0.5 s, 1.0 s simulated; the full run ~400 lumps over 2 s,
-3 s simulated.
+3 s simulated; --stop and --duration set the release time and the simulated time (s).
+Wall and process CPU time of each case's simulation (the sensor set-up not included).
 """
 
 import argparse
@@ -53,6 +61,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from tailbeam.errors import WorkLimitError  # noqa: E402
 from tailbeam.io.scene_file import loads_scene  # noqa: E402
 from tailbeam.solvers.modal_setup.setup import stream_setup  # noqa: E402
 from tailbeam.solvers.stream.solver import simulate_stream  # noqa: E402
@@ -71,13 +80,15 @@ CASES = (
     ("mu=0.7 mu_r=0.7", 0.7, 0.7, HEIGHT),
     ("low drop, frictionless", None, None, LOW),
     ("low drop, mu=0.7 mu_r=0.7", 0.7, 0.7, LOW),
+    ("low drop, mu=0.7 mu_r=0.7 d=0.01mm", 0.7, 0.7, LOW),
 )
+PENETRATION = {"low drop, mu=0.7 mu_r=0.7 d=0.01mm": 1e-5}  # m: IMPACT d, else 1e-4
 
 SCENE = """
 duration = {duration}
 [contact]
 damping = 300.0
-penetration = 1e-4
+penetration = {penetration}
 {friction}
 [plate]
 model = "modal"
@@ -119,36 +130,43 @@ rolling = {mu_r}
 """
 
 
-def scene_text(mu, mu_r, *, stop, duration, height=HEIGHT, seed=1) -> str:
-    """The study's scene file: frictionless when ``mu`` is None."""
+def scene_text(mu, mu_r, *, stop, duration, height=HEIGHT, seed=1, penetration=1e-4) -> str:
+    """The study's scene file: frictionless when ``mu`` is None; ``penetration``: the IMPACT
+    law's d (m)."""
     friction = "" if mu is None else FRICTION.format(mu=mu, mu_r=mu_r)
     return SCENE.format(
-        duration=duration, stop=stop, seed=seed, friction=friction, h0=height[0], h1=height[1]
-    )
+        duration=duration, stop=stop, seed=seed, friction=friction, h0=height[0], h1=height[1],
+        penetration=penetration,
+    )  # fmt: skip
 
 
-def run_case(mu, mu_r, *, stop, duration, height=HEIGHT, sensors=True):
+def run_case(mu, mu_r, *, stop, duration, height=HEIGHT, sensors=True, penetration=1e-4):
     """(result, wall time s) of one case: contacts on the rigid plate, its plate loads driving
     the modal plate one way."""
-    scene = loads_scene(scene_text(mu, mu_r, stop=stop, duration=duration, height=height))
+    text = scene_text(mu, mu_r, stop=stop, duration=duration, height=height,
+                      penetration=penetration)  # fmt: skip
+    scene = loads_scene(text)
     frames = np.arange(0.0, duration + 0.5 * FRAME_STEP, FRAME_STEP)
     frames = frames[frames <= duration]
     setup = stream_setup(scene) if sensors else None
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     result = simulate_stream(
         scene.particles, scene.incline, scene.duration, laws=scene.contacts(), setup=setup,
         sensors=scene.sensors if sensors else (), frames=frames, friction=scene.friction,
     )  # fmt: skip
-    return result, time.perf_counter() - start
+    return result, (time.perf_counter() - start, time.process_time() - cpu)
 
 
 def lump_table(result) -> list:
     """Per lump: name, label, radius, t_release, first plate touch (s, nan: never), t_leave
-    (s, nan: still there), plate impacts, first impact's peak force (N) and time (s), on the
-    beam at the end, at rest at the end."""
+    (s, nan: still there), plate impacts, first impact's peak force (N), on the beam at the
+    end, at rest at the end (slower than REST_SPEED), asleep at the end (frozen by the rest
+    rule: velocity exactly zero), times frozen (contact records ending ``rest``) and the
+    first freeze (s, nan: never)."""
     parts = result.particles_table()
     imp = result.impacts_table()
     plate = imp["partner"] == "plate"
+    rest = imp["end"] == "rest"
     last = result.frames.position.shape[0] - 1
     pos, vel = result.frames.position[last], result.frames.velocity[last]
     rows = []
@@ -158,6 +176,7 @@ def lump_table(result) -> list:
         r = float(parts["radius"][i])
         on_beam = bool(np.isfinite(pos[i, 2]) and pos[i, 2] - r < ON_BEAM_GAP)
         speed = float(np.linalg.norm(vel[i])) if on_beam else math.nan
+        frozen = np.flatnonzero(rest & (imp["ball"] == name))
         rows.append(
             {
                 "name": name,
@@ -170,9 +189,22 @@ def lump_table(result) -> list:
                 "first_peak_force": math.nan if first is None else float(imp["peak_force"][first]),
                 "on_beam_end": on_beam,
                 "at_rest_end": bool(on_beam and speed < REST_SPEED),
+                "asleep_end": bool(on_beam and speed == 0.0),
+                "freezes": len(set(np.round(imp["t_end"][frozen], 12))),
+                "t_first_rest": float(imp["t_end"][frozen].min()) if frozen.size else math.nan,
             }
         )
     return rows
+
+
+def sensor_signals(result) -> dict:
+    """The result's sensor signals, or none (said on stderr) where their replay would pass
+    the plate response's memory bound (long resting contacts: many load nodes)."""
+    try:
+        return result.sensor_signals
+    except WorkLimitError as err:
+        print(f"  sensor replay left out: {err}", file=sys.stderr)
+        return {}
 
 
 def auc(coal, gangue) -> float:
@@ -205,6 +237,7 @@ def summarise(name, result, lumps, wall, duration) -> dict:
     residence = np.array([r["t_leave"] - r["t_touch"] for r in left])
     on_end = [r for r in lumps if r["on_beam_end"]]
     rest_end = [r for r in on_end if r["at_rest_end"]]
+    asleep_end = [r for r in on_end if r["asleep_end"]]
     coal = [r for r in touched if r["label"] == "coal"]
     gangue = [r for r in touched if r["label"] != "coal"]
     row = {
@@ -216,14 +249,18 @@ def summarise(name, result, lumps, wall, duration) -> dict:
         "plate_impacts_per_lump": float(np.mean([r["plate_impacts"] for r in touched])),
         "on_beam_end": len(on_end),
         "at_rest_end": len(rest_end),
+        "asleep_end": len(asleep_end),
+        "ever_frozen": sum(1 for r in lumps if r["freezes"] > 0),
+        "freezes": sum(r["freezes"] for r in lumps),
         "fraction_at_rest": len(rest_end) / max(1, len(touched)),
         "auc_peak_force": auc(
             [r["first_peak_force"] for r in coal], [r["first_peak_force"] for r in gangue]
         ),
         "energy_friction_J": float(result.stats.get("energy_friction", 0.0)),
-        "wall_s": wall,
+        "wall_s": wall[0],
+        "cpu_s": wall[1],
     }
-    signals = result.sensor_signals
+    signals = sensor_signals(result)
     for sensor, (t, a) in signals.items():
         band = t <= duration
         row[f"{sensor}_rms"] = math.sqrt(float(np.mean(a[band] ** 2)))
@@ -266,16 +303,20 @@ def write_table(path, rows, args):
         ("plate_impacts_per_lump", "plate contact records per lump"),
         ("on_beam_end", "on the beam at the end"),
         ("at_rest_end", "of them at rest"),
+        ("asleep_end", "of them asleep"),
+        ("ever_frozen", "lumps ever frozen"),
         ("S1_rms", "S1 RMS (m/s²)"),
         ("S2_rms", "S2 RMS (m/s²)"),
         ("auc_peak_force", "AUC first peak force"),
         ("auc_S1_window_rms", "AUC S1 20 ms RMS"),
         ("energy_friction_J", "friction's energy (J)"),
         ("wall_s", "wall (s)"),
+        ("cpu_s", "CPU (s)"),
     ]
     cols = [c for c in cols if c[0] in rows[0]]
     lines = [
-        f"python benchmarks/study_friction_stream.py --out DIR{' --quick' if args.quick else ''}",
+        "python benchmarks/study_friction_stream.py --out DIR "
+        + " ".join(f'"{a}"' if " " in a else a for a in args.argv),
         "",
         "| " + " | ".join(c[1] for c in cols) + " |",
         "|" + "---|" * len(cols),
@@ -302,10 +343,20 @@ def case_data(result, lumps) -> dict:
         "impact_ball": np.array([index[b] for b in imp["ball"][plate]], dtype=int),
         "impact_t": np.asarray(imp["t_start"][plate], float),
         "impact_x": np.asarray(imp["x"][plate], float),
+        "t_first_rest": np.array([r["t_first_rest"] for r in lumps]),
     }
-    for sensor, (t, a) in result.sensor_signals.items():
+    for sensor, (t, a) in sensor_signals(result).items():
         data[f"signal_{sensor}_t"], data[f"signal_{sensor}_a"] = np.asarray(t), np.asarray(a)
     return data
+
+
+def display(case: str) -> str:
+    """The case's name for a reader: ``mu=0.3`` -> ``μ = 0.3, μr = 0.1``."""
+    for name, mu, mu_r, height in CASES:
+        if name == case and mu is not None:
+            d = f", d = {PENETRATION[name] * 1e3:g} mm" if name in PENETRATION else ""
+            return ("low drop, " if height == LOW else "") + f"μ = {mu:g}, μr = {mu_r:g}" + d
+    return case
 
 
 def npz_name(case: str) -> str:
@@ -314,8 +365,9 @@ def npz_name(case: str) -> str:
 
 def plot_lumps(path, runs, duration):
     """Plate-frame x of every lump from its first plate contact on against t, one panel per
-    case: thin in flight, thick while it touches the plate, a dot at each plate impact, a
-    circle where it is at rest."""
+    case, downhill pointing down: thin in flight, thick while it touches the plate, a dot at
+    each plate impact, blue where it is asleep (frozen by the rest rule: velocity exactly
+    zero), a hollow circle where it is on the plate slower than REST_SPEED but integrated."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -323,49 +375,72 @@ def plot_lumps(path, runs, duration):
 
     ncol = min(4, len(runs))
     nrow = math.ceil(len(runs) / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 3.4 * nrow + 0.6), sharey=True,
-                             squeeze=False)  # fmt: skip
+    fig, axes = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 3.4 * nrow + 0.6 + 0.5 * (ncol < 3)),
+                             sharey=True, squeeze=False)  # fmt: skip
     for ax, (name, d) in zip(axes.flat, runs, strict=False):
-        t, pos = d["times"], d["position"]
-        on = pos[:, :, 2] - d["radius"][None, :] < ON_BEAM_GAP
-        for i, label in enumerate(d["label"]):
-            if not np.isfinite(d["t_touch"][i]):
-                continue
-            colour = COLOURS.get(str(label), "tab:orange")
-            x = np.where(t >= d["t_touch"][i] - 0.5 * FRAME_STEP, pos[:, i, 0], np.nan)
-            ax.plot(t, x, color=colour, lw=0.4, alpha=0.6)
-            ax.plot(t, np.where(on[:, i], x, np.nan), color=colour, lw=1.8)
-            mine = d["impact_ball"] == i
-            ax.plot(d["impact_t"][mine], d["impact_x"][mine], ".", ms=3.0, color=colour)
-            rest = on[:, i] & (d["speed"][:, i] < REST_SPEED)
-            if rest.any():
-                ax.plot(t[rest], pos[rest, i, 0], "o", ms=3.0, mfc="none", color="tab:blue",
-                        mew=0.6)  # fmt: skip
-        ax.set_title(name, fontsize=10)
+        _lump_panel(ax, d)
+        ax.set_title(display(name), fontsize=10)
         ax.set_xlabel("t (s)")
         ax.set_xlim(0.0, duration)
-        ax.set_ylim(-0.32, 0.34)
-        for edge in (-0.3, 0.3):
-            ax.axhline(edge, color="0.5", lw=0.6, ls="--")
-        ax.grid(alpha=0.3)
     for ax in axes.flat[len(runs) :]:
         ax.set_visible(False)
+    axes[0, 0].set_ylim(0.34, -0.32)  # downhill down
     for ax in axes[:, 0]:
-        ax.set_ylabel("x along the beam, downhill (m)")
+        ax.set_ylabel("x along the beam (m), downhill down")
     handles = [
         plt.Line2D([], [], color=COLOURS["coal"], lw=0.5, label="coal (thin: in flight)"),
         plt.Line2D([], [], color=COLOURS["gangue"], lw=0.5, label="sandstone"),
         plt.Line2D([], [], color="0.3", lw=1.8, label="touching the plate"),
         plt.Line2D([], [], color="0.3", ls="none", marker=".", label="plate impact"),
+        plt.Line2D([], [], color="tab:blue", lw=2.2, label="asleep (frozen at rest)"),
         plt.Line2D(
-            [], [], ls="none", marker="o", mfc="none", color="tab:blue", label="at rest (< 1 cm/s)"
+            [],
+            [],
+            ls="none",
+            marker="o",
+            mfc="none",
+            color="tab:purple",
+            label="on the plate < 1 cm/s, not frozen",
         ),  # fmt: skip
-        plt.Line2D([], [], color="0.5", ls="--", lw=0.6, label="plate edges"),
+        plt.Line2D([], [], color="0.5", ls="--", lw=0.6, label="upper / lower edge"),
     ]
-    fig.legend(handles=handles, loc="upper center", ncol=6, frameon=False, fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, 1 - 0.5 / (3.4 * nrow + 0.6)))
+    per_row = 4 if ncol > 2 else 2
+    fig.legend(handles=handles, loc="upper center", ncol=per_row, frameon=False, fontsize=9)
+    top = 0.25 * math.ceil(len(handles) / per_row) + 0.1  # inches for the legend
+    fig.tight_layout(rect=(0, 0, 1, 1 - top / fig.get_figheight()))
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _lump_panel(ax, d):
+    """One case's lumps on ``ax`` (``plot_lumps``)."""
+    t, pos, speed = d["times"], d["position"], d["speed"]
+    on = pos[:, :, 2] - d["radius"][None, :] < ON_BEAM_GAP
+    for i, label in enumerate(d["label"]):
+        if not np.isfinite(d["t_touch"][i]):
+            continue
+        colour = COLOURS.get(str(label), "tab:orange")
+        x = np.where(t >= d["t_touch"][i] - 0.5 * FRAME_STEP, pos[:, i, 0], np.nan)
+        ax.plot(t, x, color=colour, lw=0.4, alpha=0.6)
+        ax.plot(t, np.where(on[:, i], x, np.nan), color=colour, lw=1.8)
+        mine = d["impact_ball"] == i
+        ax.plot(d["impact_t"][mine], d["impact_x"][mine], ".", ms=3.0, color=colour)
+        asleep = on[:, i] & (speed[:, i] == 0.0)
+        if asleep.any():
+            ax.plot(t, np.where(asleep, x, np.nan), color="tab:blue", lw=2.2, alpha=0.8)
+        slow = on[:, i] & (speed[:, i] > 0.0) & (speed[:, i] < REST_SPEED)
+        if slow.any():
+            ax.plot(t[slow], pos[slow, i, 0], "o", ms=3.0, mfc="none", color="tab:purple",
+                    mew=0.6)  # fmt: skip
+    for edge in (-0.3, 0.3):
+        ax.axhline(edge, color="0.5", lw=0.6, ls="--")
+    ax.grid(alpha=0.3)
+
+
+def _num(row, key) -> float:
+    """A table cell as a float (nan where a case has none: no sensor replay)."""
+    value = row.get(key)
+    return math.nan if value in (None, "") else float(value)
 
 
 def plot_stats(path, rows):
@@ -375,7 +450,7 @@ def plot_stats(path, rows):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = [r["case"].replace("low drop, ", "low drop\n").replace(" mu_r", "\nmu_r") for r in rows]
+    names = [display(r["case"]).replace("low drop, ", "low drop\n") for r in rows]
     colour = ["tab:green" if r["case"].startswith("low") else "tab:blue" for r in rows]
     panels = [
         ("residence_mean_s", "mean residence on the beam (s)\nfirst touch to leaving"),
@@ -388,11 +463,16 @@ def plot_stats(path, rows):
     fig, axes = plt.subplots(1, len(panels), figsize=(3.3 * len(panels), 4.0))
     x = np.arange(len(rows))
     for ax, (key, label) in zip(axes, panels, strict=True):
-        ax.bar(x, [float(r[key]) for r in rows], color=colour, width=0.6)
+        ax.bar(x, [_num(r, key) for r in rows], color=colour, width=0.6)
         if key == "on_beam_end":
-            ax.plot(x, [float(r["at_rest_end"]) for r in rows], "o", mfc="none", color="k")
+            ax.plot(x, [_num(r, "at_rest_end") for r in rows], "o", mfc="none", color="k",
+                    ms=9, label="< 1 cm/s")  # fmt: skip
+            if "asleep_end" in rows[0]:
+                ax.plot(x, [_num(r, "asleep_end") for r in rows], "o", color="tab:blue", ms=4,
+                        label="asleep")  # fmt: skip
+            ax.legend(fontsize=7, loc="upper left", framealpha=0.9)
         if key == "auc_peak_force" and "auc_S1_window_rms" in rows[0]:
-            ax.plot(x, [float(r["auc_S1_window_rms"]) for r in rows], "o", color="tab:red",
+            ax.plot(x, [_num(r, "auc_S1_window_rms") for r in rows], "o", color="tab:red",
                     label="S1 RMS, 20 ms after it")  # fmt: skip
             ax.axhline(0.5, color="0.4", lw=0.8, ls="--")
             ax.set_ylim(0.0, 1.0)
@@ -425,10 +505,10 @@ def plot_spectrum(path, runs):
         if "frictionless" in name:
             base[low] = p
         if not low:
-            top.semilogy(f / 1e3, p, lw=0.9, label=name, color=colour[name])
+            top.semilogy(f / 1e3, p, lw=0.9, label=display(name), color=colour[name])
         if low in base and "frictionless" not in name:
             bottom.plot(f / 1e3, 10 * np.log10(p / base[low]), lw=0.9, ls="--" if low else "-",
-                        label=name, color=colour[name])  # fmt: skip
+                        label=display(name), color=colour[name])  # fmt: skip
     top.set_ylabel("S1 PSD ((m/s²)²/Hz)")
     top.set_title("S1 acceleration, one-way modal replay (10 kHz band), Welch, 50 Hz bins",
                   fontsize=10)  # fmt: skip
@@ -436,6 +516,8 @@ def plot_spectrum(path, runs):
     top.legend(fontsize=8)
     bottom.axhline(0.0, color="0.3", lw=0.8)
     bottom.set_ylabel("over frictionless (dB)")
+    bottom.set_title("each case over the frictionless one of its release heights (dashed: low "
+                     "drop over low drop)", fontsize=9)  # fmt: skip
     bottom.set_xlabel("frequency (kHz)")
     bottom.set_xlim(0.0, 10.0)
     bottom.grid(alpha=0.3)
@@ -452,9 +534,14 @@ def main(argv=None):
     ap.add_argument("--no-sensors", action="store_true", help="rigid plate only, no replay")
     ap.add_argument("--cases", nargs="*", help="names of the cases to run (default: all)")
     ap.add_argument("--replot", action="store_true", help="figures from the saved cases only")
+    ap.add_argument("--stop", type=float, help="release lumps until this time (s)")
+    ap.add_argument("--duration", type=float, help="simulated time (s)")
     args = ap.parse_args(argv)
+    given = list(sys.argv[1:] if argv is None else argv)
+    args.argv = [a for k, a in enumerate(given) if "--out" not in given[max(0, k - 1) : k + 1]]
     args.out.mkdir(parents=True, exist_ok=True)
     stop, duration = (0.5, 1.0) if args.quick else (2.0, 3.0)
+    stop, duration = args.stop or stop, args.duration or duration
     cases = [c for c in CASES if not args.cases or c[0] in args.cases]
     if args.replot:
         with (args.out / "cases.csv").open() as fh:
@@ -466,7 +553,8 @@ def main(argv=None):
         for name, mu, mu_r, height in cases:
             print(f"case {name}", file=sys.stderr)
             result, wall = run_case(mu, mu_r, stop=stop, duration=duration, height=height,
-                                    sensors=not args.no_sensors)  # fmt: skip
+                                    sensors=not args.no_sensors,
+                                    penetration=PENETRATION.get(name, 1e-4))  # fmt: skip
             lumps = lump_table(result)
             write_csv(args.out / f"lumps_{name.replace(' ', '_').replace(',', '')}.csv", lumps)
             row = summarise(name, result, lumps, wall, duration)
@@ -481,7 +569,8 @@ def main(argv=None):
     plot_stats(args.out / "friction-stream-stats.png", rows)
     if any("signal_S1_a" in d for _, d in runs):
         plot_spectrum(args.out / "friction-stream-spectrum.png", runs)
-    print((args.out / "table.md").read_text())
+    if (args.out / "table.md").exists():
+        print((args.out / "table.md").read_text())
 
 
 if __name__ == "__main__":
