@@ -10,7 +10,7 @@ from skfem import Basis, ElementHex1
 from tailbeam.physics.materials import CARBON_STEEL
 from tailbeam.plate.fe.mesh import MESH_DIR
 from tailbeam.plate.solid import read_volume_mesh
-from tailbeam.plate.solid.impact_face import impact_face
+from tailbeam.plate.solid.face.plane import impact_face
 
 
 def _script():

@@ -1,5 +1,5 @@
-"""A structure's fast impact-face readings (tailbeam.plate.solid.face_readings) and its face
-compliance matrix (tailbeam.plate.solid.face_compliance) against the slow paths they replace
+"""A structure's fast impact-face readings (tailbeam.plate.solid.face.readings) and its face
+compliance matrix (tailbeam.plate.solid.face.compliance) against the slow paths they replace
 on the stream solver: the probe's reading (scikit-fem's inverse mapping and basis functions
 in the owning cell) and the direct factorised solve per point, on hexahedra and tetrahedra,
 with a hinge (a DOF shared by the face's edge) and a spring; a face of non-parallelogram
@@ -11,7 +11,7 @@ import pytest
 from solid_meshes import box_mesh, tet_plate_mesh
 
 from tailbeam.plate.solid import Support, assemble_structure, structure_modes
-from tailbeam.plate.solid.face_readings import face_readings
+from tailbeam.plate.solid.face.readings import face_readings
 from tailbeam.solvers.stream.plate import StreamPlate
 
 FACES = {

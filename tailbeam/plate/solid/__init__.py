@@ -1,7 +1,8 @@
 """Any linear elastic structure from a volume mesh: the mesh and its named groups
 (``volume_mesh``), quadratic solid elements (``elasticity``), supports (``supports``), the
-impact face (``impact_face``), the outer surface and readings on it (``surface``, ``probe``),
-the assembled structure (``model``) and its modes as a ``ModalBasis`` (``modes``).
+impact face, fast readings and the static compliance on it (the ``face`` subpackage), the
+outer surface and readings anywhere on it (``surface``, ``probe``), the assembled structure
+(``model``) and its modes as a ``ModalBasis`` (``modes``).
 
     from tailbeam.plate.solid import Support, assemble_structure, structure_modes
 """

@@ -10,7 +10,7 @@ stored in the file and checked on load. A damaged file is recomputed and overwri
 a note.
 
 The static compliances under contact discs (the residual flexibility's K^-1) come from the
-impact face's compliance matrix (``tailbeam.plate.solid.face_compliance``: minutes of solves
+impact face's compliance matrix (``tailbeam.plate.solid.face.compliance``: minutes of solves
 on the example beam), kept beside the basis, one file per structure (``static_key``: the
 same key without the band; ``StaticCompliances``).
 """
@@ -21,8 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from tailbeam.plate import cache as disk
-from tailbeam.plate.solid.face_compliance import FaceCompliance, face_dofs, face_green
-from tailbeam.plate.solid.face_readings import model_readings
+from tailbeam.plate.solid.face.compliance import FaceCompliance, face_dofs, face_green
+from tailbeam.plate.solid.face.readings import model_readings
 from tailbeam.plate.solid.model import StructureModel
 from tailbeam.progress import note
 
@@ -95,7 +95,7 @@ def store_basis(path: Path, key: str, freqs, phi, info: dict) -> None:
 
 class StaticCompliances:
     """``model.static_compliance`` on the impact face (1 N spread over a disc): through the
-    face's compliance matrix (``tailbeam.plate.solid.face_compliance``: K^-1 on the face's
+    face's compliance matrix (``tailbeam.plate.solid.face.compliance``: K^-1 on the face's
     DOFs, the direct solve's value for any point and radius), made on the first call with
     the model's factorisation and kept in a per-structure file (``static_key``) that later
     runs read. ``cache_dir`` None: no file. A face whose facets are not parallelograms has

@@ -13,8 +13,8 @@ from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.physics.materials import CARBON_STEEL, Material
 from tailbeam.plate.fe.model import check_points
 from tailbeam.plate.solid.elasticity import assemble_elasticity
+from tailbeam.plate.solid.face.plane import ImpactFace, impact_face
 from tailbeam.plate.solid.factor import factorize
-from tailbeam.plate.solid.impact_face import ImpactFace, impact_face
 from tailbeam.plate.solid.probe import DisplacementProbe
 from tailbeam.plate.solid.supports import (
     Support,

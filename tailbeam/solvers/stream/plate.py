@@ -29,7 +29,7 @@ from tailbeam.errors import InputError
 from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.compliance import Compliance
 from tailbeam.plate.slopes import values_and_slopes
-from tailbeam.plate.solid.face_readings import model_readings
+from tailbeam.plate.solid.face.readings import model_readings
 from tailbeam.solvers.plate_loads.propagator import advance, coefficients
 
 GRID = 61  # points per side where max |phi_k| is sampled
@@ -101,7 +101,7 @@ class StreamPlate:
 
     def _structure_residual(self, xy, radius: float) -> float:
         """``ModalBasis.residual_compliance`` of a structure at one point through its fast
-        face readings: the face compliance (``tailbeam.plate.solid.face_compliance``) minus
+        face readings: the face compliance (``tailbeam.plate.solid.face.compliance``) minus
         the kept modes' part over the same disc."""
         pts, weights = disc_rule(self.basis.plate, xy, radius)
         full = float(self.basis.static_compliance_at([xy], radius)[0])
@@ -149,7 +149,7 @@ class StreamPlate:
 
 def _face_modes(basis):
     """The mode shapes on a structure's impact face through its fast readings
-    (``tailbeam.plate.solid.face_readings``), or None (a flat plate's basis, or a face the
+    (``tailbeam.plate.solid.face.readings``), or None (a flat plate's basis, or a face the
     fast readings do not cover: the basis' own ``deflection``)."""
     model, vectors = getattr(basis, "model", None), getattr(basis, "mode_vectors", None)
     if model is None or vectors is None:

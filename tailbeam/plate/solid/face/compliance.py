@@ -2,7 +2,7 @@
 reduced DOFs the face's z-readings touch.
 
 A load of 1 N along +z spread over a disc of the face is f = R^T w (R: the face readings at
-the disc's points, ``tailbeam.plate.solid.face_readings``; w: the disc rule's weights), and
+the disc's points, ``tailbeam.plate.solid.face.readings``; w: the disc rule's weights), and
 every such f lives on the DOFs D of the face's nodes (their z-components, through the
 supports' constraint map). So the compliance f^T K^-1 f = f_D^T G f_D with G = (K^-1)_DD,
 the same value as the direct solve for any point and disc radius (to round-off; no
