@@ -22,7 +22,6 @@ import numpy as np
 
 from tailbeam.plate import cache as disk
 from tailbeam.plate.solid.face.compliance import FaceCompliance, face_dofs, face_green
-from tailbeam.plate.solid.face.readings import model_readings
 from tailbeam.plate.solid.model import StructureModel
 from tailbeam.progress import note
 
@@ -109,7 +108,7 @@ class StaticCompliances:
 
     def __call__(self, points, contact_radius: float = 0.0) -> np.ndarray:
         """(p,) mean z-deflection (m/N) over the disc under 1 N spread over it."""
-        readings = model_readings(self.model)
+        readings = self.model.face_readings()
         if readings is None:
             return self._direct(points, contact_radius)
         if self._face is None:

@@ -14,6 +14,7 @@ from tailbeam.physics.materials import CARBON_STEEL, Material
 from tailbeam.plate.fe.model import check_points
 from tailbeam.plate.solid.elasticity import assemble_elasticity
 from tailbeam.plate.solid.face.plane import ImpactFace, impact_face
+from tailbeam.plate.solid.face.readings import FaceReadings, face_readings
 from tailbeam.plate.solid.factor import factorize
 from tailbeam.plate.solid.probe import DisplacementProbe
 from tailbeam.plate.solid.supports import (
@@ -48,6 +49,7 @@ class StructureModel:
     _surface: Surface | None = field(default=None, repr=False)
     _probe: DisplacementProbe | None = field(default=None, repr=False)
     _solver: object = field(default=None, repr=False)
+    _face_readings: tuple | None = field(default=None, repr=False)  # (FaceReadings or None,)
 
     @property
     def plate(self):
@@ -61,6 +63,13 @@ class StructureModel:
         if self._probe is None:
             self._probe = DisplacementProbe(self.basis)
         return self._probe
+
+    def face_readings(self) -> FaceReadings | None:
+        """The impact face's fast readings (``face.readings``), made once; None when a facet
+        is not a parallelogram (the probe reads the face then)."""
+        if self._face_readings is None:
+            self._face_readings = (face_readings(self),)
+        return self._face_readings[0]
 
     def face_operator(self, points) -> sp.csr_matrix:
         """(p, n) z-displacement (m) at impact-face points (p, 2) from reduced vectors."""

@@ -29,7 +29,6 @@ from tailbeam.errors import InputError
 from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.compliance import Compliance
 from tailbeam.plate.slopes import values_and_slopes
-from tailbeam.plate.solid.face.readings import model_readings
 from tailbeam.solvers.plate_loads.propagator import advance, coefficients
 
 GRID = 61  # points per side where max |phi_k| is sampled
@@ -154,7 +153,7 @@ def _face_modes(basis):
     model, vectors = getattr(basis, "model", None), getattr(basis, "mode_vectors", None)
     if model is None or vectors is None:
         return None
-    readings = model_readings(model)
+    readings = model.face_readings()
     if readings is None:
         return None
     return readings.modal(np.asarray(vectors)[:, : basis.n_modes])

@@ -122,13 +122,6 @@ def _lagrange3(t) -> np.ndarray:
     return np.column_stack([2 * (t - 0.5) * (t - 1.0), -4 * t * (t - 1.0), 2 * t * (t - 0.5)])
 
 
-def model_readings(model) -> FaceReadings | None:
-    """``face_readings(model)``, made once per model and kept on it."""
-    if "face_readings" not in model.__dict__:
-        model.__dict__["face_readings"] = face_readings(model)
-    return model.__dict__["face_readings"]
-
-
 def face_readings(model) -> FaceReadings | None:
     """The FaceReadings of a StructureModel's impact face, or None when a facet is not a
     parallelogram (then the probe is the reader)."""
@@ -195,4 +188,4 @@ def _buckets(xy, plate):
     return lower, step, counts, buckets
 
 
-__all__ = ["FaceModes", "FaceReadings", "face_readings", "model_readings"]
+__all__ = ["FaceModes", "FaceReadings", "face_readings"]
