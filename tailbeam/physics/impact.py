@@ -23,7 +23,7 @@ elastic force."""
 
 import math
 
-from numba import njit
+from tailbeam.jit import njit
 
 
 @njit(cache=True, inline="always")

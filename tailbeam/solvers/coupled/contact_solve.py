@@ -27,8 +27,8 @@ tau^2), so the halved steps end in scalar equations the bracketed solve always s
 """
 
 import numpy as np
-from numba import njit
 
+from tailbeam.jit import njit
 from tailbeam.physics.impact import force_partials
 
 EPS = np.finfo(np.float64).eps

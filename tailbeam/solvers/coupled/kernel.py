@@ -21,8 +21,8 @@ A step whose contact forces are not solved (``step.solve_step``, with its fallba
 import math
 
 import numpy as np
-from numba import njit
 
+from tailbeam.jit import njit
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.coupled.step import CLAMPED, CONTACT, FLIGHT, solve_step
 from tailbeam.solvers.numerics.jit import helper_njit

@@ -17,8 +17,8 @@ plain Newton does not converge, ``contact_solve.solve_forces`` solves the same e
 """
 
 import numpy as np
-from numba import njit
 
+from tailbeam.jit import njit
 from tailbeam.physics.impact import force_partials
 from tailbeam.solvers.coupled.contact_solve import solve_forces
 from tailbeam.solvers.numerics.jit import helper_njit

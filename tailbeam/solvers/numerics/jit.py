@@ -24,7 +24,7 @@ the user documentation: numba/numba#1204 and #2350 on its tracker). If a numba r
 dropped it, ``HELPER_OPTIONS`` falls back to plain ``njit`` (slower, same results).
 """
 
-from numba import njit
+from tailbeam.jit import njit
 
 try:
     from numba.core.options import DefaultOptions

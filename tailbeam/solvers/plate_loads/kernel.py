@@ -27,7 +27,8 @@ so the two parts are split at the same samples and their sum is exact.
 import math
 
 import numpy as np
-from numba import njit
+
+from tailbeam.jit import njit
 
 EPS = 2.220446049250313e-16  # float64 machine epsilon
 

@@ -16,7 +16,8 @@ there instead (same result to rounding).
 import math
 
 import numpy as np
-from numba import njit
+
+from tailbeam.jit import njit
 
 # Rows of the coefficient table produced by ``coefficients``.
 P11, P12, P21, P22, A0, A1, B0, B1 = range(8)

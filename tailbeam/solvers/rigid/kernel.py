@@ -29,8 +29,8 @@ the error control grows it geometrically, which keeps the 8th-order accuracy of 
 import math
 
 import numpy as np
-from numba import njit
 
+from tailbeam.jit import njit
 from tailbeam.physics.contact_law import LAW_C, LAW_CLAMP, LAW_D
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.numerics.dop853 import growth, shrink

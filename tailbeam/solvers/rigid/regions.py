@@ -8,8 +8,8 @@ too, so integration steps never straddle a kink (see kernel.py).
 """
 
 import numpy as np
-from numba import njit
 
+from tailbeam.jit import njit
 from tailbeam.physics import impact
 from tailbeam.physics.contact_law import LAW_C, LAW_COLUMNS, LAW_D, LAW_E, LAW_K
 

@@ -16,7 +16,8 @@ between them; at the first invalid e the node before it is kept and becomes the 
 """
 
 import numpy as np
-from numba import njit
+
+from tailbeam.jit import njit
 
 
 def keep_nodes(t, f, tol: float) -> np.ndarray:

@@ -40,8 +40,8 @@ step, are found as before.
 import math
 
 import numpy as np
-from numba import njit
 
+from tailbeam.jit import njit
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.numerics.chebyshev import interpolant_max
 from tailbeam.solvers.numerics.dop853 import growth, shrink
