@@ -1,13 +1,13 @@
 """The decorator of every compiled kernel: numba's ``njit``, compiling one copy per argument type.
 
 Numba types a constant argument by its value (``Literal[int](0)``, ``Literal[bool](True)``)
-and an ``IntEnum`` member by its enum, and compiles the callee again for each such type: a
-helper called once with ``0`` and once with a variable ``i`` was compiled twice, and the
-coupled kernel's event helpers, called with ``EventCode`` members and plain integers, up to
-four times. Here a compiled function called from another compiled function is typed with
-the plain types (``int64``, ``bool``): one copy serves every call. This halves the rigid
-kernel's first compilation and cuts the coupled and stream kernels' by a quarter to a third;
-results are unchanged (the same operations on the path taken).
+and an ``IntEnum`` member by its enum, and compiles the callee once more for each such type:
+a helper called with ``0`` in one place and with a variable ``i`` in another is compiled
+twice, and an event helper called with ``EventCode`` members and with plain integers up to
+four times. Functions decorated here are typed with the plain types (``int64``, ``bool``)
+when compiled code calls them, so one copy serves every call. On a fresh cache this halves
+the rigid kernel's compilation and shortens the coupled and stream kernels' by a quarter to
+a third; results are unchanged (the same operations on the path taken).
 
 A function whose body needs a constant argument (for example to index a heterogeneous
 tuple) still gets it: if the plain types do not compile, numba's own typing is used.
