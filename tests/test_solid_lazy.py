@@ -7,7 +7,8 @@ readings; a run whose basis is cached (modes, the run-cost estimate, a face comp
 back) assembles nothing; the count of K's nonzeros kept on disk equals the assembled K's;
 a free structure is still refused without assembling; a listing of the cached modes (what
 `tailbeam modes` prints and writes) reads the same frequencies and info as the basis,
-without its vectors, and the cached command writes the solved run's frequencies.csv."""
+without its vectors, and the cached command writes the solved run's frequencies.csv; the
+volume mesh kept under its file's SHA-256 reads back equal to the file's own read."""
 
 import shutil
 from pathlib import Path
@@ -23,9 +24,11 @@ from tailbeam.plate.solid import Support, assemble_structure, structure_modes
 from tailbeam.plate.solid import cached as solid_cached
 from tailbeam.plate.solid.cost import structure_cost
 from tailbeam.plate.solid.elasticity import assemble_elasticity
+from tailbeam.plate.solid.held import mesh_digest
 from tailbeam.plate.solid.modes import cached_listing
 from tailbeam.plate.solid.probe import DisplacementProbe
 from tailbeam.plate.solid.supports import apply_supports, free_rigid_motions
+from tailbeam.plate.solid.volume_mesh import read_volume_mesh
 
 FACES = {
     "top": lambda c, n: n[2] > 0.5,
@@ -159,3 +162,28 @@ def test_cached_modes_command_writes_the_solved_frequencies(mesh, tmp_path, caps
         runs.append(((out / "frequencies.csv").read_bytes(), capsys.readouterr().out))
     assert "cache miss" in runs[0][1] and "cache hit" in runs[1][1]
     assert runs[0][0] == runs[1][0]
+
+
+def test_mesh_read_back_from_the_cache_equals_the_file_read(mesh, tmp_path, capsys):
+    fresh = read_volume_mesh(mesh)
+    digest = mesh_digest(mesh)
+    first = solid_cached.read_mesh(mesh, digest, tmp_path)  # read from the file, kept
+    again = solid_cached.read_mesh(mesh, digest, tmp_path)  # from the cache
+    for got in (first, again):
+        assert type(got.mesh) is type(fresh.mesh) and got.kind == fresh.kind
+        for name in ("p", "t", "facets", "t2f", "f2t"):
+            assert np.array_equal(getattr(got.mesh, name), getattr(fresh.mesh, name))
+        for kind in ("faces", "volumes"):
+            ours, theirs = getattr(got, kind), getattr(fresh, kind)
+            assert ours.keys() == theirs.keys()
+            assert all(np.array_equal(ours[k], theirs[k]) for k in ours)
+    assert again.source == str(mesh)
+    (entry,) = tmp_path.glob(f"{solid_cached.MESH_PREFIX}-*.npz")
+    entry.write_bytes(b"damaged")
+    capsys.readouterr()
+    back = solid_cached.read_mesh(mesh, digest, tmp_path)
+    assert "damaged" in capsys.readouterr().err
+    assert np.array_equal(back.mesh.t, fresh.mesh.t)
+    other = solid_cached.read_mesh(mesh, "0" * 64, tmp_path)  # another content: another file
+    assert len(list(tmp_path.glob(f"{solid_cached.MESH_PREFIX}-*.npz"))) == 2
+    assert np.array_equal(other.mesh.p, fresh.mesh.p)

@@ -14,9 +14,11 @@ impact face's compliance matrix (``tailbeam.plate.solid.face.compliance``: minut
 on the example beam), kept beside the basis, one file per structure (``static_key``: the
 same key without the band; ``StaticCompliances``).
 
-The run-cost estimate needs the count of K's nonzeros (``stiffness_nnz``): it is kept in a
-small per-structure file too (``matrices_key``), so that a run whose basis and compliances
-are cached assembles nothing.
+The volume mesh as read (``read_mesh``: the skfem mesh's nodes and cells, and the named
+groups) is kept under the mesh file's SHA-256, so a later run neither imports meshio nor
+parses the file. The run-cost estimate needs the count of K's nonzeros (``stiffness_nnz``):
+it is kept in a small per-structure file too (``matrices_key``), so that a run whose basis
+and compliances are cached assembles nothing.
 """
 
 import dataclasses
@@ -25,15 +27,18 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
+from skfem import MeshHex, MeshTet
 
 from tailbeam.plate import cache as disk
 from tailbeam.plate.solid.face.compliance import FaceCompliance, face_dofs, face_green
 from tailbeam.plate.solid.model import StructureModel
+from tailbeam.plate.solid.volume_mesh import VolumeMesh, read_volume_mesh
 from tailbeam.progress import note
 
 BASIS_PREFIX = "structure"
 STATIC_PREFIX = "structure-face-compliance"
 MATRICES_PREFIX = "structure-matrices"
+MESH_PREFIX = "structure-mesh"
 ROUND = 12  # decimals (m) of a point's and a radius' key in the direct solves' memo
 
 
@@ -70,6 +75,43 @@ def basis_key(model: StructureModel, fmax_hz, count) -> str:
 def static_key(model: StructureModel) -> str:
     """Hex key of the static compliances of ``model`` (no band)."""
     return disk.entry_key({**_model_meta(model), "static": True}, _mesh_arrays(model))
+
+
+def read_mesh(path, digest: str, cache_dir=None) -> VolumeMesh:
+    """The volume mesh of the file ``path`` whose bytes' SHA-256 is ``digest`` (hex): from
+    ``structure-mesh-<key>.npz`` (``cache_dir``, default $TAILBEAM_CACHE_DIR or
+    ~/.cache/tailbeam) when the same content was read before, else ``read_volume_mesh``
+    (whose errors name plate.mesh), then kept there."""
+    key = disk.entry_key({"kind": "volume mesh", "sha256": digest}, ())
+    file = disk.entry_path(cache_dir or disk.default_cache_dir(), MESH_PREFIX, key)
+    status, found = disk.read_entry(file, key)
+    if status == "hit":
+        try:
+            return _mesh_from(found, str(path))
+        except (KeyError, ValueError, IndexError) as err:
+            status, found = "damaged", f"{type(err).__name__}: {err}"
+    if status == "damaged":
+        note(f"structure cache: {file} is damaged ({found}); reading the mesh file again")
+    vmesh = read_volume_mesh(path)
+    arrays = {"p": vmesh.mesh.p, "t": vmesh.mesh.t}
+    groups = {"faces": sorted(vmesh.faces), "volumes": sorted(vmesh.volumes)}
+    for kind, names in groups.items():
+        for i, name in enumerate(names):
+            arrays[f"{kind}{i}"] = getattr(vmesh, kind)[name]
+    try:
+        disk.write_entry(file, key, arrays, {"cell": vmesh.kind, **groups})
+    except OSError:
+        pass  # an unwritable cache: the file is read again next time
+    return vmesh
+
+
+def _mesh_from(found: dict, source: str) -> VolumeMesh:
+    """The VolumeMesh of a ``read_mesh`` entry."""
+    info = found["info"]
+    cell = {"tetra": MeshTet, "hexahedron": MeshHex}[info["cell"]]
+    groups = {kind: {name: found[f"{kind}{i}"] for i, name in enumerate(info[kind])}
+              for kind in ("faces", "volumes")}  # fmt: skip
+    return VolumeMesh(cell(found["p"], found["t"]), groups["faces"], groups["volumes"], source)
 
 
 def matrices_key(model: StructureModel) -> str:
@@ -192,5 +234,5 @@ class StaticCompliances:
 
 
 __all__ = ["StaticCompliances", "basis_key", "basis_path", "load_basis", "load_frequencies",
-           "matrices_key",
+           "matrices_key", "read_mesh",
            "static_key", "stiffness_nnz", "store_basis"]  # fmt: skip

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from tailbeam.errors import InputError
 from tailbeam.physics.materials import Material
+from tailbeam.plate.solid.cached import read_mesh
 from tailbeam.plate.solid.model import StructureModel, assemble_structure
 
 MESH_FIELD = "plate.mesh"
@@ -36,7 +37,8 @@ def held_structure(path, impact_face: str, supports: tuple, material: Material) 
 
 @functools.lru_cache(maxsize=KEPT)
 def _built(path, digest, impact_face, supports, material) -> StructureModel:
-    return assemble_structure(path, impact_face, supports, material=material)
+    vmesh = read_mesh(path, digest)  # the file read once per content, then from the cache
+    return assemble_structure(vmesh, impact_face, supports, material=material)
 
 
 __all__ = ["held_structure", "mesh_digest"]
