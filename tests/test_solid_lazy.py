@@ -148,8 +148,10 @@ def test_cached_listing_reads_the_basis_frequencies_without_vectors(mesh, tmp_pa
     assert cached_listing(model, fmax_hz=4000.0, cache_dir=tmp_path) is None
 
 
-def test_cached_modes_command_writes_the_solved_frequencies(mesh, tmp_path, capsys):
+def test_cached_modes_command_writes_the_solved_frequencies(mesh, tmp_path, capsys, monkeypatch):
     from test_solid_cache import SCENE
+
+    monkeypatch.setenv("TAILBEAM_CACHE_DIR", str(tmp_path / "cache"))  # a cache of its own
 
     from tailbeam.cli.main import main
 
