@@ -7,7 +7,14 @@ Beam: meshes/tail_beam.msh (``--mesh``), pinned at ``hinge``, the jack a spring 
 ``--jack`` N/m on ``jack``, every mode below ``--fmax`` (cold: assembly, Sylvester count,
 shift-invert Lanczos), peak resident memory of the process (getrusage); then the same basis
 read back from the disk cache (a fresh temporary folder): its load time, file size and
-whether it equals the solved one bit for bit.
+whether it equals the solved one bit for bit; then ``tailbeam modes`` on a scene of the same
+structure and band, run ``--cached-runs`` times (3) in fresh processes with that cache
+folder: each run's CPU time (user + system, the operating system's count for the child),
+wall time, peak memory (the largest child's so far, the runs being started from a small
+process) and whether it read the cache (``DIR/cached_runs.csv``): the cached
+path end to end (interpreter start, imports, the scene's checks, the basis read back).
+``--cached-only FOLDER`` does only those runs, on ``--scene`` (examples/tail_beam_stream.toml)
+and a cache folder its structure's basis to ``--fmax`` was solved into before.
 
 ``--refine SIZE``: the example beam against the same beam meshed at SIZE m (meshes/tail_beam.py,
 gmsh), every mode below ``--refine-fmax`` (2 kHz): the rib-stiffened box against a finer
@@ -26,7 +33,8 @@ tetrahedra over in-plane divisions, against the converged Reissner-Mindlin plate
 32 divisions) and with the Mindlin-Kirchhoff difference beside it: the first 30 frequencies'
 largest relative difference. Needs gmsh only for the beam mesh when it is absent.
 
-Writes DIR/bench_structure_modes.csv (beam), DIR/cache_load.csv (--load-only),
+Writes DIR/bench_structure_modes.csv (beam), DIR/cached_runs.csv, DIR/cache_load.csv
+(--load-only),
 DIR/element_study.csv, DIR/refinement.csv, DIR/impacts.csv and DIR/table.md.
 Single-threaded BLAS (OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1) for reproducible timings.
 """
@@ -35,6 +43,7 @@ import argparse
 import csv
 import os
 import resource
+import subprocess
 import sys
 import tempfile
 import time
@@ -59,12 +68,92 @@ def cpu_s() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def beam(mesh: Path, fmax: float, jack: float) -> dict:
+SCENE = """duration = 0.001
+
+[plate]
+model = "modal"
+material = "carbon_steel"
+mesh = "{mesh}"
+impact_face = "top"
+fmax = {fmax}
+
+[[plate.supports]]
+group = "hinge"
+kind = "pinned"
+
+[[plate.supports]]
+group = "jack"
+kind = "spring"
+stiffness = {jack}
+
+[[balls]]
+name = "lump"
+material = "sandstone"
+radius = 0.03
+position = [0.45, 0.0, 0.031]
+velocity = [0.0, 0.0, -2.0]
+"""
+
+
+def children_usage() -> tuple:
+    """(CPU s, peak resident GB) of this process' finished children so far."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024**2
+
+
+def cached_runs(scene: Path, fmax: float, folder, runs: int) -> list:
+    """``tailbeam modes SCENE --fmax FMAX``, ``runs`` times in fresh processes reading the
+    basis from the cache ``folder`` (module docstring)."""
+    env = {**os.environ, "TAILBEAM_CACHE_DIR": str(folder), "OMP_NUM_THREADS": "1",
+           "OPENBLAS_NUM_THREADS": "1", "PYTHONPATH": str(ROOT)}  # fmt: skip
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="tailbeam-bench-modes-") as tmp:
+        for i in range(runs):
+            cpu0, _ = children_usage()
+            load, w = os.getloadavg()[0], time.perf_counter()
+            done = subprocess.run([sys.executable, "-m", "tailbeam", "modes", str(scene),
+                                   "--fmax", str(fmax), "--out", str(Path(tmp) / f"out{i}")],
+                                  env=env, capture_output=True, text=True)  # fmt: skip
+            wall = time.perf_counter() - w
+            cpu1, peak = children_usage()
+            first = (done.stdout.splitlines() or [""])[0]
+            if done.returncode:
+                print(done.stderr, file=sys.stderr, flush=True)
+            rows.append({"run": i + 1, "exit": done.returncode,
+                         "cache_hit": first.endswith("cache hit"), "cpu_s": cpu1 - cpu0,
+                         "wall_s": wall, "peak_gb_largest_so_far": peak,
+                         "load_average_1min": (load + os.getloadavg()[0]) / 2})  # fmt: skip
+            print(rows[-1], flush=True)
+    return rows
+
+
+def cached_runs_apart(scene: Path, fmax: float, folder, runs: int) -> list:
+    """``cached_runs`` from a fresh, small process (this script with ``--cached-only``): a
+    child started from this process would count its memory at the start as its own."""
+    out = Path(folder) / "cached-runs"
+    subprocess.run([sys.executable, __file__, "--out", str(out), "--cached-only", str(folder),
+                    "--scene", str(scene), "--fmax", str(fmax), "--cached-runs", str(runs)],
+                   check=True)  # fmt: skip
+    with open(out / "cached_runs.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    floats = ("cpu_s", "wall_s", "peak_gb_largest_so_far", "load_average_1min")
+    return [{k: float(v) if k in floats else v for k, v in row.items()} for row in rows]
+
+
+def beam_scene(folder, mesh: Path, fmax: float, jack: float) -> Path:
+    """A scene file in ``folder`` of the benchmark's structure (``SCENE``)."""
+    scene = Path(folder) / "beam.toml"
+    scene.write_text(SCENE.format(mesh=Path(mesh).resolve(), fmax=float(fmax), jack=jack))
+    return scene
+
+
+def beam(mesh: Path, fmax: float, jack: float, runs: int = 3) -> tuple:
     from tailbeam.plate.solid import Support, assemble_structure, structure_modes
 
     t0, c0 = time.perf_counter(), cpu_s()
     supports = [Support("pinned", group="hinge"), Support("spring", group="jack", stiffness=jack)]
     model = assemble_structure(mesh, "top", supports)
+    _ = model.stiffness  # assembled here (else on the eigen-solve's first use), timed apart
     t1 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="tailbeam-bench-cache-") as folder:
         basis = structure_modes(model, fmax_hz=fmax, cache_dir=folder)  # cold: solved, saved
@@ -73,6 +162,7 @@ def beam(mesh: Path, fmax: float, jack: float) -> dict:
         again = structure_modes(model, fmax_hz=fmax, cache_dir=folder)  # read back
         t3 = time.perf_counter()
         size = Path(basis.info["cache_file"]).stat().st_size
+        cli = cached_runs_apart(beam_scene(folder, mesh, fmax, jack), fmax, folder, runs)
     same = np.array_equal(again.mode_vectors, basis.mode_vectors) and np.array_equal(
         again.frequencies_hz, basis.frequencies_hz
     )
@@ -84,7 +174,7 @@ def beam(mesh: Path, fmax: float, jack: float) -> dict:
             "cached_load_s": t3 - t2, "cache_file_mb": size / 1e6,
             "cached_equal": bool(same and again.info["cache"] == "hit"),
             "load_average_1min": os.getloadavg()[0], "peak_gb": peak_gb(),
-            "first_10_hz": " ".join(f"{v:.1f}" for v in f[:10])}  # fmt: skip
+            "first_10_hz": " ".join(f"{v:.1f}" for v in f[:10])}, cli  # fmt: skip
 
 
 def load_only(mesh: Path, jack: float, n_modes: int = 477) -> list:
@@ -237,6 +327,19 @@ def main(argv=None):
     parser.add_argument("--study", action="store_true", help="also the element study")
     parser.add_argument("--skip-beam", action="store_true")
     parser.add_argument("--load-only", action="store_true", help="only the cache's load time")
+    parser.add_argument("--cached-runs", type=int, default=3, help="cached tailbeam modes runs")
+    parser.add_argument(
+        "--cached-only",
+        type=Path,
+        metavar="FOLDER",
+        help="only the cached runs, on a cache folder filled before",
+    )
+    parser.add_argument(
+        "--scene",
+        type=Path,
+        default=ROOT / "examples" / "tail_beam_stream.toml",
+        help="the scene of --cached-only",
+    )
     parser.add_argument("--rungs", type=int, nargs="+", default=[12, 16, 24, 32])
     parser.add_argument(
         "--refine",
@@ -259,11 +362,17 @@ def main(argv=None):
         print(rows, flush=True)
         write_csv(args.out / "cache_load.csv", rows)
         parts.append("## Cached basis load\n\n" + table(rows))
+    elif args.cached_only:
+        rows = cached_runs(args.scene, args.fmax, args.cached_only, args.cached_runs)
+        write_csv(args.out / "cached_runs.csv", rows)
+        parts.append("## Cached `tailbeam modes`\n\n" + table(rows))
     elif not args.skip_beam:
-        row = beam(args.mesh, args.fmax, args.jack)
+        row, rows = beam(args.mesh, args.fmax, args.jack, args.cached_runs)
         print(row, flush=True)
         write_csv(args.out / "bench_structure_modes.csv", [row])
+        write_csv(args.out / "cached_runs.csv", rows)
         parts.append("## Tail beam modes\n\n" + table([row]))
+        parts.append("## Cached `tailbeam modes`\n\n" + table(rows))
     if args.study:
         rows = element_study(args.rungs)
         write_csv(args.out / "element_study.csv", rows)

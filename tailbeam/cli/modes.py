@@ -265,6 +265,7 @@ def _structure(args, scene, fmax) -> int:
     --vtu) the volume mesh's modes.vtu."""
     from tailbeam.plate.solid import structure_modes
     from tailbeam.plate.solid.held import held_structure
+    from tailbeam.plate.solid.modes import cached_listing
 
     settings = scene.modal
     if fmax is None and args.count is None:
@@ -274,7 +275,10 @@ def _structure(args, scene, fmax) -> int:
         raise InputError("--png", "draws a flat plate's modes; for a structure use --vtu")
     model = held_structure(settings.mesh, settings.impact_face, settings.supports,
                            scene.plate.material)  # fmt: skip
-    basis = structure_modes(model, fmax_hz=fmax, count=args.count, use_cache=not args.no_cache)
+    basis = None if args.vtu or args.no_cache else cached_listing(model, fmax_hz=fmax,
+                                                                  count=args.count)  # fmt: skip
+    if basis is None:  # not cached, or the shapes are wanted: the whole basis
+        basis = structure_modes(model, fmax_hz=fmax, count=args.count, use_cache=not args.no_cache)
     info = basis.info
     print(
         f"structure {settings.mesh} ({basis.boundary}), {scene.plate.material.name}: "

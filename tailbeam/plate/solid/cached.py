@@ -13,20 +13,32 @@ The static compliances under contact discs (the residual flexibility's K^-1) com
 impact face's compliance matrix (``tailbeam.plate.solid.face.compliance``: minutes of solves
 on the example beam), kept beside the basis, one file per structure (``static_key``: the
 same key without the band; ``StaticCompliances``).
+
+The volume mesh as read (``read_mesh``: the skfem mesh's nodes and cells, and the named
+groups) is kept under the mesh file's SHA-256, so a later run neither imports meshio nor
+parses the file. The run-cost estimate needs the count of K's nonzeros (``stiffness_nnz``):
+it is kept in a small per-structure file too (``matrices_key``), so that a run whose basis
+and compliances are cached assembles nothing.
 """
 
 import dataclasses
+import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
+from skfem import MeshHex, MeshTet
 
 from tailbeam.plate import cache as disk
 from tailbeam.plate.solid.face.compliance import FaceCompliance, face_dofs, face_green
 from tailbeam.plate.solid.model import StructureModel
+from tailbeam.plate.solid.volume_mesh import VolumeMesh, read_volume_mesh
 from tailbeam.progress import note
 
 BASIS_PREFIX = "structure"
 STATIC_PREFIX = "structure-face-compliance"
+MATRICES_PREFIX = "structure-matrices"
+MESH_PREFIX = "structure-mesh"
 ROUND = 12  # decimals (m) of a point's and a radius' key in the direct solves' memo
 
 
@@ -65,6 +77,68 @@ def static_key(model: StructureModel) -> str:
     return disk.entry_key({**_model_meta(model), "static": True}, _mesh_arrays(model))
 
 
+def read_mesh(path, digest: str, cache_dir=None) -> VolumeMesh:
+    """The volume mesh of the file ``path`` whose bytes' SHA-256 is ``digest`` (hex): from
+    ``structure-mesh-<key>.npz`` (``cache_dir``, default $TAILBEAM_CACHE_DIR or
+    ~/.cache/tailbeam) when the same content was read before, else ``read_volume_mesh``
+    (whose errors name plate.mesh), then kept there."""
+    key = disk.entry_key({"kind": "volume mesh", "sha256": digest}, ())
+    file = disk.entry_path(cache_dir or disk.default_cache_dir(), MESH_PREFIX, key)
+    status, found = disk.read_entry(file, key)
+    if status == "hit":
+        try:
+            return _mesh_from(found, str(path))
+        except (KeyError, ValueError, IndexError) as err:
+            status, found = "damaged", f"{type(err).__name__}: {err}"
+    if status == "damaged":
+        note(f"structure cache: {file} is damaged ({found}); reading the mesh file again")
+    vmesh = read_volume_mesh(path)
+    arrays = {"p": vmesh.mesh.p, "t": vmesh.mesh.t}
+    groups = {"faces": sorted(vmesh.faces), "volumes": sorted(vmesh.volumes)}
+    for kind, names in groups.items():
+        for i, name in enumerate(names):
+            arrays[f"{kind}{i}"] = getattr(vmesh, kind)[name]
+    try:
+        disk.write_entry(file, key, arrays, {"cell": vmesh.kind, **groups})
+    except OSError:
+        pass  # an unwritable cache: the file is read again next time
+    return vmesh
+
+
+def _mesh_from(found: dict, source: str) -> VolumeMesh:
+    """The VolumeMesh of a ``read_mesh`` entry."""
+    info = found["info"]
+    cell = {"tetra": MeshTet, "hexahedron": MeshHex}[info["cell"]]
+    groups = {kind: {name: found[f"{kind}{i}"] for i, name in enumerate(info[kind])}
+              for kind in ("faces", "volumes")}  # fmt: skip
+    return VolumeMesh(cell(found["p"], found["t"]), groups["faces"], groups["volumes"], source)
+
+
+def matrices_key(model: StructureModel) -> str:
+    """Hex key of the quantities of ``model``'s assembled K and M kept on disk (no band)."""
+    return disk.entry_key({**_model_meta(model), "matrices": True}, _mesh_arrays(model))
+
+
+def stiffness_nnz(model: StructureModel, cache_dir=None) -> int:
+    """Stored nonzeros of the reduced stiffness K of ``model``: the count kept in
+    ``structure-matrices-<key>.npz`` (``cache_dir``, default $TAILBEAM_CACHE_DIR or
+    ~/.cache/tailbeam), else K's own (assembled if it is not yet), then kept there."""
+    key = matrices_key(model)
+    path = disk.entry_path(cache_dir or disk.default_cache_dir(), MATRICES_PREFIX, key)
+    status, found = disk.read_entry(path, key)
+    if status == "hit" and "stiffness_nnz" in found:
+        return int(found["stiffness_nnz"])
+    if status == "damaged":
+        note(f"structure cache: {path} is damaged ({found}); recomputing it")
+    nnz = int(model.stiffness.nnz)
+    try:
+        disk.write_entry(path, key, {"stiffness_nnz": np.array(nnz, dtype=np.int64)},
+                         {"what": "nonzeros of the reduced stiffness K"})  # fmt: skip
+    except OSError:
+        pass  # an unwritable cache: the next run counts them again
+    return nnz
+
+
 def basis_path(cache_dir, key: str) -> Path:
     return disk.entry_path(cache_dir or disk.default_cache_dir(), BASIS_PREFIX, key)
 
@@ -81,6 +155,18 @@ def load_basis(path: Path, key: str, n_dofs: int):
     if status == "damaged":
         note(f"basis cache: {path} is damaged ({found}); recomputing it")
     return None
+
+
+def load_frequencies(path: Path, key: str):
+    """(frequencies Hz, info) of the entry, without reading its vectors (a listing of the
+    modes), or None: missing, another key's, or unreadable (``load_basis`` then decides)."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if "vectors.npy" not in data.zip.namelist() or str(data["key"]) != key:
+                return None
+            return data["frequencies_hz"], json.loads(str(data["info"]))
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+        return None
 
 
 def store_basis(path: Path, key: str, freqs, phi, info: dict) -> None:
@@ -147,5 +233,6 @@ class StaticCompliances:
         return np.array([self._values[k] for k in keys])
 
 
-__all__ = ["StaticCompliances", "basis_key", "basis_path", "load_basis", "static_key",
-           "store_basis"]  # fmt: skip
+__all__ = ["StaticCompliances", "basis_key", "basis_path", "load_basis", "load_frequencies",
+           "matrices_key", "read_mesh",
+           "static_key", "stiffness_nnz", "store_basis"]  # fmt: skip

@@ -127,9 +127,10 @@ def solve_cost(n_dofs: int, nnz: int, n_modes: int, extra: int = 0) -> Structure
 def structure_cost(model, fmax_hz: float) -> StructureSolveCost:
     """The estimated cost of ``modes.structure_modes(model, fmax_hz=...)`` (a
     StructureModel)."""
+    from tailbeam.plate.solid.cached import stiffness_nnz
     from tailbeam.plate.solid.modes import MARGIN
 
     volume, area = mesh_volume_area(model.vmesh.mesh)
     n_modes = modes_below(volume, area, model.plate.material, fmax_hz)
-    nnz = int(model.stiffness.nnz)
+    nnz = stiffness_nnz(model)  # from the cache when K was assembled before
     return solve_cost(model.n_dofs, nnz, n_modes, model.rigid_modes + MARGIN)

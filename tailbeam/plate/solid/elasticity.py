@@ -44,6 +44,15 @@ def vector_basis(mesh, kind: str) -> Basis:
     return Basis(mesh, ElementVector(ELEMENTS[kind]()), intorder=INTEGRATION_ORDER)
 
 
+def dof_basis(mesh, kind: str) -> Basis:
+    """The same displacement basis without quadrature points: its DOF numbering, DOF
+    locations, element and mapping are those of ``vector_basis`` (they do not depend on the
+    quadrature), without the basis values and gradients at every cell's quadrature points
+    that only the assembly needs (seconds and hundreds of MB on a beam's mesh)."""
+    none = (np.zeros((mesh.dim(), 0)), np.zeros(0))
+    return Basis(mesh, ElementVector(ELEMENTS[kind]()), quadrature=none)
+
+
 def assemble_elasticity(mesh, kind: str, material: Material) -> Elasticity:
     """Stiffness and mass of an isotropic linear elastic solid (``material``: E Pa, nu, rho
     kg/m^3) on ``mesh`` (``kind`` 'tetra' or 'hexahedron').
@@ -53,7 +62,12 @@ def assemble_elasticity(mesh, kind: str, material: Material) -> Elasticity:
     ``skfem.models.elasticity.linear_elasticity`` (checked against it in the tests), whose
     pair-by-pair assembly takes minutes on a beam's mesh.
     """
-    basis = vector_basis(mesh, kind)
+    return assemble_on(vector_basis(mesh, kind), material, ELEMENT_NAMES[kind])
+
+
+def assemble_on(basis: Basis, material: Material, element: str) -> Elasticity:
+    """``assemble_elasticity`` on a given vector ``basis`` (its quadrature integrates)."""
+    mesh = basis.mesh
     scalar = basis.split_bases()[0]
     lam, mu = lame_parameters(material.youngs_modulus, material.poisson_ratio)
     grads = np.array([scalar.basis[a][0].grad for a in range(scalar.Nbfun)])  # (nb, 3, e, q)
@@ -68,7 +82,7 @@ def assemble_elasticity(mesh, kind: str, material: Material) -> Elasticity:
     mass = sum(
         _assemble(m_scalar, dofs[c].T, basis.N) for c in range(3)
     )  # the same scalar mass on each component
-    return Elasticity(basis, stiffness, mass.tocsr(), ELEMENT_NAMES[kind])
+    return Elasticity(basis, stiffness, mass.tocsr(), element)
 
 
 CHUNK = 500  # cells per batch of element matrices (~50 MB each for Q2 hexahedra)

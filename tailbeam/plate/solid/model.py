@@ -1,6 +1,11 @@
 """The assembled structure: a volume mesh with its elasticity, supports and impact face;
 its stiffness and mass on the held DOFs q (full displacements u = T q), the operators that
 read displacements on the impact face and anywhere on the surface, and static solves.
+
+Building a model checks everything a scene needs checked (the mesh, the face, the supports,
+that they hold the structure) from the mesh's geometry and the DOF numbering alone; the
+stiffness and mass are assembled on first use (an eigen-solve, a static solve), so a run
+whose basis and compliances come from the cache assembles nothing.
 """
 
 from dataclasses import dataclass, field
@@ -12,7 +17,7 @@ from tailbeam.errors import InputError, require_nonnegative
 from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.physics.materials import CARBON_STEEL, Material
 from tailbeam.plate.fe.model import check_points
-from tailbeam.plate.solid.elasticity import assemble_elasticity
+from tailbeam.plate.solid.elasticity import ELEMENT_NAMES, assemble_on, dof_basis, vector_basis
 from tailbeam.plate.solid.face.plane import ImpactFace, impact_face
 from tailbeam.plate.solid.face.readings import FaceReadings, face_readings
 from tailbeam.plate.solid.factor import factorize
@@ -33,19 +38,23 @@ SUPPORTS_FIELD = "plate.supports"
 class StructureModel:
     """A held (or deliberately free) linear elastic structure.
 
-    stiffness, mass : (n, n) CSR on the reduced DOFs q (u = transform @ q), N/m and kg.
+    basis : the displacement basis' DOF numbering, element and mapping (``dof_basis``).
+    transform : (N, n) CSR, full DOFs u = transform @ q.
+    spring : (N, N) CSR, the spring supports' stiffness on the full DOFs, N/m.
     rigid_modes : rigid-body motions left free (0 unless built with ``free=True``).
+    ``stiffness`` and ``mass`` ((n, n) CSR on q, N/m and kg) are assembled on first use.
     """
 
     vmesh: VolumeMesh
     face: ImpactFace
     basis: object
     element: str
-    stiffness: sp.csr_matrix
-    mass: sp.csr_matrix
     transform: sp.csr_matrix
+    spring: sp.csr_matrix
     rigid_modes: int
     supports: tuple
+    material: Material
+    _matrices: tuple | None = field(default=None, repr=False)  # (stiffness, mass)
     _surface: Surface | None = field(default=None, repr=False)
     _probe: DisplacementProbe | None = field(default=None, repr=False)
     _solver: object = field(default=None, repr=False)
@@ -57,7 +66,32 @@ class StructureModel:
 
     @property
     def n_dofs(self) -> int:
-        return int(self.stiffness.shape[0])
+        return int(self.transform.shape[1])
+
+    @property
+    def stiffness(self) -> sp.csr_matrix:
+        return self._assembled()[0]
+
+    @property
+    def mass(self) -> sp.csr_matrix:
+        return self._assembled()[1]
+
+    @property
+    def assembled(self) -> bool:
+        """Whether the stiffness and mass have been assembled (they are on first use)."""
+        return self._matrices is not None
+
+    def _assembled(self) -> tuple:
+        """(stiffness, mass) on the reduced DOFs, assembled once with the full quadrature."""
+        if self._matrices is None:
+            full = vector_basis(self.vmesh.mesh, self.vmesh.kind)
+            if full.N != self.basis.N:
+                raise RuntimeError("the assembly's DOF numbering differs from the model's")
+            elastic = assemble_on(full, self.material, self.element)
+            t = self.transform
+            k = (t.T @ ((elastic.stiffness + self.spring) @ t)).tocsr()
+            self._matrices = (k, (t.T @ (elastic.mass @ t)).tocsr())
+        return self._matrices
 
     def probe(self) -> DisplacementProbe:
         if self._probe is None:
@@ -143,7 +177,9 @@ def assemble_structure(
     material: Material = CARBON_STEEL,
     free: bool = False,
 ) -> StructureModel:
-    """Assemble a structure from a volume mesh (a path, or a VolumeMesh).
+    """A structure from a volume mesh (a path, or a VolumeMesh): the mesh read, the impact
+    face, the supports applied and checked (a structure they do not hold is refused); the
+    stiffness and mass are assembled on first use (``StructureModel.stiffness``).
 
     Parameters
     ----------
@@ -163,9 +199,9 @@ def assemble_structure(
     face = impact_face(vmesh, impact_face_name, material)
     fields = [f"{SUPPORTS_FIELD}[{i}]" for i in range(1, len(supports) + 1)]
     supports = tuple(check_support(s, f) for s, f in zip(supports, fields, strict=True))
-    elastic = assemble_elasticity(vmesh.mesh, vmesh.kind, material)
-    cons = apply_supports(elastic.basis, vmesh, supports, fields)
-    rigid = free_rigid_motions(elastic.basis, cons)
+    basis = dof_basis(vmesh.mesh, vmesh.kind)
+    cons = apply_supports(basis, vmesh, supports, fields)
+    rigid = free_rigid_motions(basis, cons)
     if rigid and not free:
         said = "no supports" if not supports else "these supports"
         raise InputError(
@@ -173,11 +209,8 @@ def assemble_structure(
             f"the structure is not held: {rigid} rigid-body motion(s) stay free with {said}; "
             "add supports, or ask for a free structure",
         )
-    t = cons.transform
-    k = (t.T @ ((elastic.stiffness + cons.spring) @ t)).tocsr()
-    m = (t.T @ (elastic.mass @ t)).tocsr()
-    return StructureModel(vmesh, face, elastic.basis, elastic.element, k, m, t, rigid,
-                          supports)  # fmt: skip
+    return StructureModel(vmesh, face, basis, ELEMENT_NAMES[vmesh.kind], cons.transform,
+                          cons.spring, rigid, supports, material)  # fmt: skip
 
 
 __all__ = ["StructureModel", "Support", "assemble_structure"]

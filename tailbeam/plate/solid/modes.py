@@ -71,6 +71,34 @@ class StructureModalBasis(ModalBasis):
         return mesh.p[:, nodes].T.copy(), cells, self.nodal_displacements(nodes)
 
 
+@dataclass(frozen=True)
+class StructureModesListing:
+    """The frequencies (Hz) and ``info`` of a structure's cached basis, without its mode
+    vectors: what a listing of the modes needs (``cached_listing``)."""
+
+    frequencies_hz: np.ndarray
+    info: dict
+    boundary: str
+    theory: str = THEORY
+
+    @property
+    def n_modes(self) -> int:
+        return len(self.frequencies_hz)
+
+
+def cached_listing(model: StructureModel, *, fmax_hz=None, count=None, cache_dir=None):
+    """The StructureModesListing of the basis ``structure_modes`` would read from the cache
+    (the same key), reading its frequencies only; None when it is not cached there."""
+    key = cached.basis_key(model, fmax_hz, count)
+    path = cached.basis_path(cache_dir or default_cache_dir(), key)
+    found = cached.load_frequencies(path, key)
+    if found is None:
+        return None
+    freqs, info = found
+    info.update(cache="hit", cache_file=str(path))
+    return StructureModesListing(np.asarray(freqs, dtype=float), info, _boundary(model))
+
+
 def _shift(model: StructureModel, fmax_hz: float | None) -> float:
     """A shift below every eigenvalue (negative), small next to the band's."""
     if fmax_hz is not None:
