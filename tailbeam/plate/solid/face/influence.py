@@ -19,6 +19,7 @@ import numpy as np
 
 from tailbeam.plate import cache as disk
 from tailbeam.plate.solid.cached import static_key
+from tailbeam.progress import note
 
 PREFIX = "structure-sensor-influence"
 
@@ -77,8 +78,14 @@ def _influence_vectors(model, operator, points, directions, cache_dir) -> np.nda
             if vector is not None and vector.shape == (n,):
                 out[:, j] = vector
                 continue
+            if status != "missing":
+                why = found if status == "damaged" else "its vector does not fit the structure"
+                note(f"sensor influence cache: {paths[j][0]} is damaged ({why}); recomputing it")
         todo.append(j)
     if todo:
+        where = "cached" if cache_dir is not None else "not cached"
+        note(f"sensor influence: one static solve for each of {len(todo)} sensor signal(s), "
+             f"{where}")  # fmt: skip
         rhs = np.asarray(operator[todo].T.todense())
         out[:, todo] = model.solver().solve(rhs).reshape(rhs.shape)
         for j in todo:
