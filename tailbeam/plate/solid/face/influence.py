@@ -24,10 +24,12 @@ from tailbeam.progress import note
 PREFIX = "structure-sensor-influence"
 
 
-def influence_key(model, point, direction) -> str:
+def influence_key(model, point, direction, structure_key=None) -> str:
     """Hex key of the influence vector of the channel at surface ``point`` (3,) m along the
-    unit ``direction`` (3,) on ``model`` (a StructureModel)."""
-    meta = {"static_key": static_key(model), "sensor_point": [float(v) for v in point],
+    unit ``direction`` (3,) on ``model`` (a StructureModel); ``structure_key``: its
+    ``static_key`` when known (a hash of the whole mesh)."""
+    meta = {"static_key": structure_key or static_key(model),
+            "sensor_point": [float(v) for v in point],
             "sensor_direction": [float(v) for v in direction]}  # fmt: skip
     return disk.entry_key(meta, ())
 
@@ -69,9 +71,10 @@ def _influence_vectors(model, operator, points, directions, cache_dir) -> np.nda
     n, p = model.n_dofs, operator.shape[0]
     out = np.empty((n, p))
     paths, todo = [None] * p, []
+    structure_key = static_key(model) if cache_dir is not None else None
     for j in range(p):
         if cache_dir is not None:
-            key = influence_key(model, points[j], directions[j])
+            key = influence_key(model, points[j], directions[j], structure_key)
             paths[j] = (disk.entry_path(cache_dir, PREFIX, key), key)
             status, found = disk.read_entry(*paths[j])
             vector = found.get("vector") if status == "hit" else None
