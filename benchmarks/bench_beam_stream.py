@@ -12,8 +12,8 @@ keep the stream itself (1000 lumps at 200 per second, radii, heights, seed). ``-
 and ``--stop`` shorten both (a prefix of the same stream). Each run is ``tailbeam simulate``
 in a fresh process; its CPU time (user + system) and peak resident memory come from the
 operating system (``os.wait4``), so a shared machine's load changes the wall time, not
-these. The beam's basis and face compliance are read from the cache when warmed before (the
-first run solves them: run this twice, or ``tailbeam modes`` first, to time the stream).
+these. The beam's basis, face compliance and its sensors' static influences are read from the
+cache when warmed before (the first run solves them: run this twice to time the stream).
 
 Writes DIR/beam.toml, DIR/flat.toml, each run's output folder, DIR/bench_beam_stream.csv and
 DIR/table.md.

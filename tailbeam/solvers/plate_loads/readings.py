@@ -16,13 +16,16 @@ this reads the slope of w where the plate's own rotation differs from it by the 
 The static part (the full model's displacement at the channel under 1 N pressing on the
 impact face, for the truncated modes' quasi-static response) is taken by Maxwell-Betti
 reciprocity: one static solve per channel under a unit force at the channel along its
-direction, read as the z-displacement at the load points.
+direction, read as the z-displacement at the load points. On a structure those solutions
+are kept in the cache beside its basis (``tailbeam.plate.solid.face.influence``), so a run
+whose channels were solved before factorises nothing for them.
 """
 
 import numpy as np
 
 from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.slopes import values_and_slopes
+from tailbeam.plate.solid.face.influence import FaceInfluence
 
 
 class Readings:
@@ -38,7 +41,7 @@ class Readings:
         self.basis = basis
         self.channels = tuple(channels)
         self.model = getattr(basis, "model", None)  # a StructureModel, or None: the flat plate
-        self._columns = self._shapes = None
+        self._influence = self._shapes = None
         self.static = None
         if getattr(basis, "static_deflection_at", None) is not None:
             self.static = self._static_solid if self.model is not None else self._static_flat
@@ -103,11 +106,14 @@ class Readings:
         return self._flat_reading(at).T
 
     def _static_solid(self, loads) -> np.ndarray:
-        if self._columns is None:  # K^-1 of a unit force at each channel along its direction
-            rhs = np.asarray(self._operator().T.todense())
-            self._columns = self.model.solver().solve(rhs).reshape(rhs.shape)
-        loads = np.atleast_2d(np.asarray(loads, dtype=float))
-        return np.asarray(self.model.face_operator(loads) @ self._columns)
+        """(q, p) by reciprocity from each channel's K^-1 of a unit force at it along its
+        direction (``FaceInfluence``: cached beside the basis)."""
+        if self._influence is None:
+            pts, dirs = self._points_directions()
+            dirs = dirs / np.linalg.norm(dirs, axis=1, keepdims=True)
+            cache_dir = getattr(self.basis.static_compliance_at, "cache_dir", None)
+            self._influence = FaceInfluence(self.model, self._operator(), pts, dirs, cache_dir)
+        return self._influence(loads)
 
     def residual_cross(self, load_point, contact_radius: float = 0.0) -> np.ndarray:
         """(p,) static displacement (m/N) of the modes left out at the channels under 1 N

@@ -25,7 +25,7 @@ from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.fe.model import check_points
 from tailbeam.progress import note, task
-from tailbeam.signals.sensor import measure
+from tailbeam.signals.sensor import SensorSpec, measure
 from tailbeam.solvers.plate_loads.kernel import (
     add_particular,
     empty_outputs,
@@ -93,17 +93,15 @@ def plate_response(
     batch_nodes, max_bytes : int, float
         Load nodes per batch of mode shapes; memory bound (bytes, WorkLimitError above it).
     readings : Readings, optional
-        Observe these sensor channels (``tailbeam.solvers.plate_loads.readings``: any surface
-        point and direction) instead of the deflection at ``points`` (then ignored).
+        Also observe these sensor channels (``tailbeam.solvers.plate_loads.readings``: any
+        surface point and direction): their rows follow those of ``points`` (None or empty:
+        the channels only).
     """
     omega = np.ascontiguousarray(basis.omega, dtype=float)
     if modal:  # the identity as the "shapes at the points": the outputs are q, q', q''
         pts, phi_pts, quasi_static = None, np.eye(omega.shape[0]), False
-    elif readings is not None:
-        pts, phi_pts = None, np.ascontiguousarray(readings.shapes(), dtype=float)
     else:
-        pts = check_points(basis.plate, points, "points")
-        phi_pts = np.ascontiguousarray(basis.deflection(pts), dtype=float)
+        pts, phi_pts = _observed(basis, points, readings)
     t0, dt, n_samples = uniform_times(times)
     zeta = _zeta(zeta, omega.shape[0])
     xyr = _load_points(basis, loads, load_radius)
@@ -114,13 +112,28 @@ def plate_response(
     grid = (t0, dt, n_samples)
     batching = (int(batch_nodes), float(node_time_ulps))
     what = "modal coordinates" if modal else "plate response at the sensors"
+    split = 0 if pts is None else len(pts)  # the points' rows, then the channels'
     g, h, seen = _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, grid, batching, out,
-                            what)  # fmt: skip
+                            what, split)  # fmt: skip
     r = np.zeros_like(g)
     if quasi_static:
         r = _residual(basis, xyr, pts, seen, g, readings)
     _add_particular_all(loads, nodes, t0, dt, g, h, r, out)
     return dict(zip(("w", "v", "a"), out, strict=True))
+
+
+def _observed(basis, points, readings) -> tuple:
+    """(points (p, 2) m checked, or None; shapes (p + c, n_modes)): the deflection at the
+    points, then the channels of ``readings`` (if any), each read along its direction."""
+    if readings is None:
+        pts = check_points(basis.plate, points, "points")
+        return pts, np.ascontiguousarray(basis.deflection(pts), dtype=float)
+    rows, pts = [], None
+    if points is not None and len(points):
+        pts = check_points(basis.plate, points, "points")
+        rows.append(basis.deflection(pts))
+    rows.append(readings.shapes())
+    return pts, np.ascontiguousarray(np.vstack(rows), dtype=float)
 
 
 def _check_batching(node_time_ulps, batch_nodes):
@@ -186,11 +199,12 @@ def node_jumps(loads, t0: float, dt: float, n_samples: int) -> dict:
     return {"df": df, "ds": ds, "target": target, "last": last}
 
 
-def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, out, what):
+def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, out, what,
+               split=0):  # fmt: skip
     """Run ``march`` over all samples, the nodes in batches of ``batch_nodes`` (their pieces'
     mode shapes evaluated per batch); times = (t0 s, dt s, N), batching = (batch_nodes,
-    node_time_ulps); ``what`` names the progress. Returns G, H (pieces, p) and which pieces
-    were seen."""
+    node_time_ulps); ``what`` names the progress; ``split``: the rows of the points, before
+    the channels' (``_by_block``). Returns G, H (pieces, p) and which pieces were seen."""
     n_pieces = xyr.shape[0]
     t0, dt, n_samples = times
     batch_nodes, ulps = batching
@@ -206,6 +220,7 @@ def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, 
     qh, vh = np.zeros(omega.shape[0]), np.zeros(omega.shape[0])
     g_pts = (phi_pts / w2).T
     h_pts = (phi_pts * (2.0 * zeta / omega**3)).T
+    evaluate = shape_reader(basis)
     order = np.argsort(nodes["target"], kind="stable")
     n_act = int(np.searchsorted(nodes["target"], n_samples, sorter=order))
     done = -1
@@ -219,8 +234,9 @@ def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, 
             sel = order[start:stop]
             pieces = np.searchsorted(first, sel, side="right") - 1
             uniq, rows = np.unique(pieces, return_inverse=True)
-            phi_tab = load_shapes(basis, xyr[uniq])
-            g[uniq], h[uniq], seen[uniq] = phi_tab @ g_pts, phi_tab @ h_pts, True
+            phi_tab = load_shapes(basis, xyr[uniq], evaluate)
+            g[uniq], h[uniq] = _by_block(phi_tab, g_pts, split), _by_block(phi_tab, h_pts, split)
+            seen[uniq] = True
             march(done + 1, last_j, t0, dt, pdt, mu, zw, w2, qh, vh, phi_pts,
                   nodes["target"][sel], t_nodes[sel], rows.ravel().astype(np.int64),
                   nodes["df"][sel], nodes["ds"][sel], phi_tab, ulps, *out)  # fmt: skip
@@ -234,10 +250,37 @@ def _march_all(basis, omega, zeta, xyr, loads, nodes, phi_pts, times, batching, 
     return g, h, seen
 
 
-def load_shapes(basis, xyr) -> np.ndarray:
+def _by_block(left, right, split):
+    """left @ right as two products, right's columns [:split] and [split:] (the points' and
+    the channels'), so each block's values do not depend on the other block: a plain sensor
+    reads the same, bit for bit, beside other channels."""
+    if 0 < split < right.shape[1]:
+        return np.hstack([left @ right[:, :split], left @ right[:, split:]])
+    return left @ right
+
+
+def load_shapes(basis, xyr, evaluate=None) -> np.ndarray:
     """(k, n_modes) mode shapes under the loads xyr (k, 3) (x, y m; radius m: 0 a point,
-    else the mean over the disc, as ModalBasis.load_deflection); each distinct load once."""
-    return disc_average(basis.plate, xyr, basis.deflection)
+    else the mean over the disc, as ModalBasis.load_deflection); each distinct load once.
+    ``evaluate``: the mode shapes at points (``shape_reader``; default the basis')."""
+    return disc_average(basis.plate, xyr, evaluate or basis.deflection)
+
+
+def shape_reader(basis):
+    """points (q, 2) m -> (q, n_modes) mode shapes: on a structure whose impact face has
+    fast readings, their interpolation of the mode vectors (``FaceReadings.modal``: the
+    probe's values to round-off, without a sparse product with the whole basis per call);
+    else ``basis.deflection``."""
+    model, vectors = getattr(basis, "model", None), getattr(basis, "mode_vectors", None)
+    readings = None if model is None or vectors is None else model.face_readings()
+    if readings is None:
+        return basis.deflection
+    face = readings.modal(np.asarray(vectors)[:, : basis.n_modes])
+
+    def evaluate(points):
+        return face(check_points(basis.plate, points, "points"))
+
+    return evaluate
 
 
 def disc_average(plate, xyr, evaluate) -> np.ndarray:
@@ -270,8 +313,8 @@ def _residual(basis, xyr, pts, seen, g, readings=None) -> np.ndarray:
     reciprocity as the deflection at the load (disc-averaged) under a unit point load at
     each point: p static solutions, evaluated at the load points in batches. Zeros (with a
     note) if the basis has no static deflection; WorkLimitError if the estimated time (from
-    the first batch) exceeds MAX_QUASI_STATIC_S. With ``readings`` the points are its
-    channels and the static part is theirs (``Readings.static``)."""
+    the first batch) exceeds MAX_QUASI_STATIC_S. With ``readings`` its channels follow the
+    points (``pts`` None: none) and their static part is theirs (``Readings.static``)."""
     r = np.zeros_like(g)
     if getattr(basis, "static_deflection_at", None) is None:
         note(f"no quasi-static correction: the {basis.theory} basis has no static deflection")
@@ -280,11 +323,12 @@ def _residual(basis, xyr, pts, seen, g, readings=None) -> np.ndarray:
     uniq, inv = np.unique(xyr[idx], axis=0, return_inverse=True)
     full = np.empty((uniq.shape[0], g.shape[1]))
 
-    def static(q):
-        return np.column_stack([basis.static_deflection_at(p, q, 0.0) for p in pts])
+    at_points = _point_statics(basis, pts)
 
-    if readings is not None:
-        static = readings.static
+    def static(q):
+        if readings is None:
+            return at_points(q)
+        return readings.static(q) if pts is None else np.hstack([at_points(q), readings.static(q)])
 
     with task("quasi-static correction", total=uniq.shape[0], unit="load points") as bar:
         for k in range(0, uniq.shape[0], RESIDUAL_BATCH):
@@ -298,6 +342,23 @@ def _residual(basis, xyr, pts, seen, g, readings=None) -> np.ndarray:
             bar.update(min(RESIDUAL_BATCH, uniq.shape[0] - k))
     r[idx] = full[inv.ravel()] - g[idx]
     return r
+
+
+def _point_statics(basis, pts):
+    """load points (q, 2) m -> (q, p): the static deflection (m/N) at the points ``pts``
+    under 1 N at each load point: by reciprocity, from the basis' static solves at the
+    points, or on a structure from the influences cached beside its basis (the points as
+    plain sensors, ``Readings``)."""
+    if pts is None:
+        return None
+    if getattr(basis, "model", None) is not None:
+        plain = [SensorSpec(f"points[{i}]", (float(x), float(y))) for i, (x, y) in enumerate(pts)]
+        return Readings(basis, plain).static
+
+    def static(q):
+        return np.column_stack([basis.static_deflection_at(p, q, 0.0) for p in pts])
+
+    return static
 
 
 def _check_residual_time(seconds_one, count):
@@ -326,37 +387,48 @@ def sensor_outputs(basis, zeta, loads, sensors, duration, *, load_radius=0.0, qu
     """name -> tailbeam.signals.sensor.SensorOutput for every channel of every sensor
     (``SensorSpec.channels``) under ``loads``: the chain of ``ModalReplay.sensor_outputs``
     (true acceleration on the sensor's fine grid, mounted resonance, anti-alias FIR, sampling,
-    noise) over [0, duration] s, driven by ``plate_response``. Plain sensors (a point (x, y)
-    read along +z) whose fine grids coincide share one plate response, the other channels
-    another (``tailbeam.solvers.plate_loads.readings``). ``sensor_signals(outputs)`` gives
-    what ``write_sensors_csv`` takes."""
+    noise) over [0, duration] s, driven by ``plate_response``. All channels whose fine grids
+    coincide share one plate response (one march of the modes over the load nodes and the
+    samples; each channel a row of mode shapes): plain sensors (a point (x, y) read along
+    +z) through the basis' deflection, the other channels through
+    ``tailbeam.solvers.plate_loads.readings``. ``sensor_signals(outputs)`` gives what
+    ``write_sensors_csv`` takes."""
     f_top = float(np.max(basis.frequencies_hz))
-    plain = [s for s in sensors if s.plain]
-    other = [c for s in sensors if not s.plain for c in s.channels()]
+    rows, plain, other = _sensor_rows(sensors)
     positions = np.array([s.position for s in plain], dtype=float).reshape(-1, 2)
     readings = Readings(basis, other) if other else None
     done = {}
 
-    def acceleration(times, index, group):
-        key = (len(times), float(times[1] - times[0]), group)
+    def acceleration(times, row):
+        key = (len(times), float(times[1] - times[0]))
         if key not in done:
             response = plate_response(
                 basis, zeta, loads, positions, times,
-                load_radius=load_radius, quasi_static=quasi_static,
-                readings=readings if group else None,
+                load_radius=load_radius, quasi_static=quasi_static, readings=readings,
             )  # fmt: skip
             done[key] = response["a"]
-        return done[key][index]
+        return done[key][row]
 
     out = {}
-    for s in sensors:
-        for c in s.channels():
-            group = not s.plain
-            i = other.index(c) if group else plain.index(s)
-            out[c.name] = measure(
-                c, lambda t, i=i, g=group: acceleration(t, i, g), duration, max_frequency_hz=f_top
-            )
+    for c, row in rows:
+        out[c.name] = measure(
+            c, lambda t, row=row: acceleration(t, row), duration, max_frequency_hz=f_top
+        )
     return out
+
+
+def _sensor_rows(sensors) -> tuple:
+    """([(channel, its row of the plate response)], the plain sensors, read by the basis'
+    deflection at their points, the other channels, read by ``Readings``, after them)."""
+    plain = [s for s in sensors if s.plain]
+    other = [c for s in sensors if not s.plain for c in s.channels()]
+    rows = []
+    for s in sensors:
+        if s.plain:
+            rows.append((s, plain.index(s)))
+            continue
+        rows += [(c, len(plain) + other.index(c)) for c in s.channels()]
+    return rows, plain, other
 
 
 @dataclass(frozen=True, eq=False)
