@@ -236,6 +236,8 @@ class Islands:
     def _advance_all(self, t: float, t_stop: float) -> dict:
         """Each island advanced from t to the earliest event of all (or t_stop): islands
         that went past it are put back and advanced again up to it."""
+        if len(self.islands) == 1:  # (nothing to put back)
+            return {isl: isl.advance(t, t_stop) for isl in self.islands}
         snaps = {isl: isl.snapshot() for isl in self.islands}
         outs = {}
         best = t_stop
