@@ -117,9 +117,11 @@ class Islands:
         if isl is self.newcomers:
             self.newcomers = None
 
-    def _regroup(self, groups) -> None:
+    def _regroup(self, groups, watch=None) -> None:
         """Make the islands ``groups`` (lists of balls): an island whose members stay
-        together is kept as it is; the others are rebuilt from their balls' islands."""
+        together is kept as it is; the others are rebuilt from their balls' islands.
+        ``watch``: the ball pairs that can touch (``group``; None: the new islands watch
+        every pair of their members, the kept ones what they watched)."""
         kept = {frozenset(isl.members): isl for isl in self.islands}
         new = []
         for g in groups:
@@ -127,6 +129,9 @@ class Islands:
             if isl is None:
                 isl = self._new()
                 isl.adopt(g, [p.export() for p in {self.of[i] for i in g}])
+                isl.watch = watch
+            elif watch is not None:
+                _narrow(isl, watch)
             new.append(isl)
         for isl in kept.values():  # (their members are in the new islands now)
             self._retire(isl)
@@ -169,10 +174,11 @@ class Islands:
         e = 0.5 * b.mass[i] * float(v @ v) + 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
         return e + self.of[i].elastic_energy_of(i)
 
-    def group(self, horizon: float) -> list:
+    def group(self, horizon: float) -> tuple[list, set]:
         """The islands for the next ``horizon`` (s): touching balls together, then groups
         whose balls could come into contact within it (``speed_bounds``) merged until none
-        can (lists of balls, in member order)."""
+        can. Returns the islands (lists of balls, in member order) and the pairs (i, j),
+        i < j, that could touch within it (each island watches only those)."""
         m = list(self.members)
         pos = {i: q for q, i in enumerate(m)}
         root = list(range(len(m)))
@@ -203,7 +209,8 @@ class Islands:
                     root[ra] = rc
                     joined = True
             if not joined:
-                return groups
+                watch = {(min(m[a], m[c]), max(m[a], m[c])) for a, c in zip(qi, qj, strict=True)}
+                return groups, watch
 
     # --- integration ------------------------------------------------------------------------
     def next_event(self, t: float, t_stop: float):
@@ -215,7 +222,7 @@ class Islands:
         self.newcomers = None
         if t_stop > self.valid_until:
             horizon = max(HORIZON, t_stop - t)
-            self._regroup(self.group(horizon))
+            self._regroup(*self.group(horizon))
             self.valid_until = t + horizon
             self.retired["island_regroups"] += 1
         outs = self._advance_all(t, t_stop)
@@ -324,7 +331,10 @@ class Islands:
     def start_contact(self, key):
         """Pair ``key`` starts touching now (found in closed form): its balls' islands merge."""
         balls = [k for k in key if k >= 0]
-        self._merge(balls).start_contact(key)
+        isl = self._merge(balls)
+        if isl.watch is not None and key[1] >= 0 and key not in isl.watch:
+            isl.rewatch(None)  # (not found by the island itself: watch every pair)
+        isl.start_contact(key)
 
     def impulses(self, key) -> np.ndarray:
         return self.of[key[0]].impulses(key)
@@ -351,6 +361,16 @@ class Islands:
     def tail_energy(self) -> float:
         """0: no tails on the rigid plate."""
         return 0.0
+
+
+def _narrow(isl, watch) -> None:
+    """Island ``isl`` (kept) watches the pairs of ``watch`` among its members: rebuilt when
+    it misses one of them or watches more than twice as many (and 8) as needed."""
+    members = set(isl.members)
+    need = {k for k in watch if k[0] in members and k[1] in members}
+    have = {k for k in isl.keys if k[1] >= 0} if not isl.dirty else None
+    if have is None or not need <= have or len(have) > 2 * len(need) + 8:
+        isl.rewatch(watch)
 
 
 def _groups(members, roots) -> list:

@@ -81,6 +81,7 @@ class ActiveMembers:
         self.members, self.quiet = [], set()  # quiet: members resting on the plate
         self.keys, self.index, self.local, self.pairs_of = [], {}, {}, {}
         self.set, self.dirty, self.h = None, True, 0.0
+        self.watch = None  # ball pairs watched (None: every pair of members; ``rewatch``)
         self.kinks = []
         self._x, self._v = {}, {}  # states of the members while the set is not built
         self._pairs = {}  # pair key -> its state in the set last synced
@@ -188,9 +189,7 @@ class ActiveMembers:
     def _build(self):
         b, m = self.balls, self.members
         old = self._pairs
-        self.keys = [(i, -1) for i in m] + [
-            (min(i, j), max(i, j)) for a, i in enumerate(m) for j in m[a + 1 :]
-        ]
+        self.keys = [(i, -1) for i in m] + self._ball_pairs(old)
         local = {i: q for q, i in enumerate(m)}
         pairs = [(local[i], -1 if j < 0 else local[j]) for i, j in self.keys]
         laws = [b.table.law(i, PLATE if j < 0 else j) for i, j in self.keys]
@@ -221,6 +220,23 @@ class ActiveMembers:
             self.carried.restore(s, local, self.index)
         self.dirty = False
         self.totals["rebuilds"] += 1
+
+    def _ball_pairs(self, old) -> list:
+        """The ball-ball pair keys the set watches: every pair of members, or those in
+        ``watch`` and those touching (``old``: the pair states by key)."""
+        m = self.members
+        keys = [(min(i, j), max(i, j)) for a, i in enumerate(m) for j in m[a + 1 :]]
+        if self.watch is None:
+            return keys
+        return [k for k in keys if k in self.watch or (k in old and old[k][0])]
+
+    def rewatch(self, watch) -> None:
+        """Watch only the ball pairs in ``watch`` (a set of keys (i, j), i < j, that holds
+        every pair of members that can touch until the caller says otherwise; None: every
+        pair): the set is rebuilt on its next use."""
+        self._sync()
+        self.watch = watch
+        self.dirty = True
 
     def _plate_friction(self, modal) -> dict:
         """With friction on the modal plate: what the friction table of a set rebuilt with the
