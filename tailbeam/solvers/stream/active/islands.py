@@ -128,7 +128,7 @@ class Islands:
             isl = kept.pop(frozenset(g), None)
             if isl is None:
                 isl = self._new()
-                isl.adopt(g, [p.export() for p in {self.of[i] for i in g}])
+                isl.adopt(g, [p.export() for p in dict.fromkeys(self.of[i] for i in g)])
                 isl.watch = watch
             elif watch is not None:
                 _narrow(isl, watch)

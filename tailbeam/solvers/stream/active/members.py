@@ -162,7 +162,11 @@ class ActiveMembers:
         carried rows, next step), for an ``adopt`` by another set (an island's members
         regrouped, ``islands``); spins go to ``balls.w``."""
         self._sync()
-        return dict(x=dict(self._x), v=dict(self._v), pairs=dict(self._pairs),
+        mine = set(self.members)
+        pairs = {
+            k: st for k, st in self._pairs.items() if k[0] in mine and (k[1] < 0 or k[1] in mine)
+        }
+        return dict(x=dict(self._x), v=dict(self._v), pairs=pairs,
                     quiet=set(self.quiet), carried=(self.carried.t, list(self.carried.rows)),
                     h=self.h)  # fmt: skip
 
