@@ -22,6 +22,10 @@ friction force's moment on the plate left out (a private switch,
 ``friction_pairs._PLATE_MOMENT``): the relative change of each sensor's in-band RMS (0-10 kHz)
 is what the moment contributes (``--skip-moment``: not run).
 
+On the rigid plate the friction case runs once more with the active set integrated as one
+set (a private switch, ``loop._ISLANDS``; ``--skip-one-set``: not run): what integrating
+its islands each with its own step saves. ``--models`` picks the plates (default both).
+
 ``--quick``: 100 particles (``--particles`` sets the count). Writes DIR/table.md,
 DIR/results.json and every case's scene and results (DIR/<case>.toml, DIR/<case>.json).
 """
@@ -64,15 +68,17 @@ def scene_text(n: int, model: str, stiction: float | None) -> str:
     return text
 
 
-def run_case(path: str, moment: bool = True) -> dict:
+def run_case(path: str, moment: bool = True, islands: bool = True) -> dict:
     """Child process: simulate the scene file; wall time, peak memory, counts, sensor RMS."""
     import resource
 
     import tailbeam
     from tailbeam.io.scene_file import load_scene
     from tailbeam.solvers.stream.active import friction_pairs
+    from tailbeam.solvers.stream.driver import loop
 
     friction_pairs._PLATE_MOMENT = moment
+    loop._ISLANDS = islands
     scene = load_scene(path)
     t0, c0 = time.perf_counter(), time.process_time()
     result = tailbeam.simulate(scene, solver="stream", progress=False)
@@ -105,10 +111,11 @@ def rms_below(t, a, f_hz: float) -> float:
     return float(np.sqrt(np.mean(np.fft.irfft(spectrum, len(a)) ** 2)))
 
 
-def _in_child(out_dir: Path, name: str, text: str, moment: bool = True) -> dict:
+def _in_child(out_dir: Path, name: str, text: str, moment: bool = True,
+              islands: bool = True) -> dict:  # fmt: skip
     path = out_dir / f"{name}.toml"
     path.write_text(text)
-    result = run_case_in_child("bench_friction_stream", str(path), moment)
+    result = run_case_in_child("bench_friction_stream", str(path), moment, islands)
     (out_dir / f"{name}.json").write_text(json.dumps(result))
     return result
 
@@ -121,22 +128,30 @@ def main(argv=None) -> int:
     parser.add_argument("--stiction", type=float, default=1e-3, help="m/s")
     parser.add_argument("--skip-moment", action="store_true",
                         help="do not run the modal case without friction's moment")  # fmt: skip
+    parser.add_argument("--skip-one-set", action="store_true",
+                        help="do not run the rigid friction case as one set")  # fmt: skip
+    parser.add_argument("--models", nargs="+", choices=("rigid", "modal"),
+                        default=["rigid", "modal"])  # fmt: skip
     args = parser.parse_args(argv)
     n = args.particles or (100 if args.quick else 1000)
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
     print(f"warm-up (numba, basis caches): {min(n, 20)} particles", file=sys.stderr)
-    for model in ("rigid", "modal"):
+    print(f"load: {os.getloadavg()}", file=sys.stderr)
+    for model in args.models:
         _in_child(out, f"warmup_{model}", scene_text(min(n, 20), model, args.stiction))
     rows, results = [], {}
-    for model in ("rigid", "modal"):
-        cases = [("frictionless", None, True), ("friction", args.stiction, True)]
+    for model in args.models:
+        cases = [("frictionless", None, True, True), ("friction", args.stiction, True, True)]
         if model == "modal" and not args.skip_moment:
-            cases.append(("friction, no moment", args.stiction, False))
-        for label, vs, moment in cases:
+            cases.append(("friction, no moment", args.stiction, False, True))
+        if model == "rigid" and not args.skip_one_set:
+            cases.append(("friction, one set", args.stiction, True, False))
+        for label, vs, moment, islands in cases:
             name = f"{model}_{label.replace(', ', '_').replace(' ', '_')}"
             print(f"{name}: {n} particles", file=sys.stderr)
-            results[name] = r = _in_child(out, name, scene_text(n, model, vs), moment)
+            text = scene_text(n, model, vs)
+            results[name] = r = _in_child(out, name, text, moment, islands)
             rows.append((model, label, r))
     (out / "results.json").write_text(json.dumps(results, indent=1))
     (out / "table.md").write_text(_table(n, args.stiction, rows, results))

@@ -101,6 +101,13 @@ class FrictionPairs:
         d = xi - xj
         dist = math.sqrt(float(d @ d))
         n = d / dist
-        u = vi + np.cross(wi, -dist * share * n) - vj - np.cross(wj, dist * (1.0 - share) * n)
+        u = vi + _cross(wi, -dist * share * n) - vj - _cross(wj, dist * (1.0 - share) * n)
         slip = u - (u @ n) * n
         return float(math.sqrt(slip @ slip))
+
+
+def _cross(a, b) -> np.ndarray:
+    """a x b of two 3-vectors (``np.cross``'s arithmetic, without its overhead on tiny
+    arrays: the driver calls it for every contact at every refresh)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])  # fmt: skip

@@ -14,6 +14,8 @@ Its parts: the plate force histories (``forces.PlateForces``), putting a member 
 (``plate_pairs.PlatePairs``).
 """
 
+import math
+
 import numpy as np
 
 from tailbeam.physics.contact_law import law_table
@@ -77,8 +79,9 @@ class ActiveMembers:
         self.carried = CarriedRows()
         self.now = 0.0
         self.members, self.quiet = [], set()  # quiet: members resting on the plate
-        self.keys, self.index, self.local = [], {}, {}
+        self.keys, self.index, self.local, self.pairs_of = [], {}, {}, {}
         self.set, self.dirty, self.h = None, True, 0.0
+        self.watch = None  # ball pairs watched (None: every pair of members; ``rewatch``)
         self.kinks = []
         self._x, self._v = {}, {}  # states of the members while the set is not built
         self._pairs = {}  # pair key -> its state in the set last synced
@@ -154,12 +157,43 @@ class ActiveMembers:
             self._build()
         return self.set
 
+    def export(self) -> dict:
+        """The members' state (positions, velocities, pair states by key, resting members,
+        carried rows, next step), for an ``adopt`` by another set (an island's members
+        regrouped, ``islands``); spins go to ``balls.w``."""
+        self._sync()
+        mine = set(self.members)
+        pairs = {
+            k: st for k, st in self._pairs.items() if k[0] in mine and (k[1] < 0 or k[1] in mine)
+        }
+        return dict(x=dict(self._x), v=dict(self._v), pairs=pairs,
+                    quiet=set(self.quiet), carried=(self.carried.t, list(self.carried.rows)),
+                    h=self.h)  # fmt: skip
+
+    def adopt(self, members, parts) -> None:
+        """Take ``members`` with their state from ``parts`` (``export``s of the sets they
+        were in, at this set's time): the set is built with them on its next use. The
+        smallest step suggested by a part is the first step; the rows carried are those of
+        the latest part."""
+        self.members = list(members)
+        for part in parts:
+            for i in self.members:
+                if i in part["x"]:
+                    self._x[i], self._v[i] = part["x"][i], part["v"][i]
+            self._pairs.update(part["pairs"])
+            self.quiet |= part["quiet"] & set(self.members)
+        steps = [p["h"] for p in parts if p["h"]]
+        self.h = min(steps) if steps else 0.0
+        t = max((p["carried"][0] for p in parts if not math.isnan(p["carried"][0])),
+                default=math.nan)  # fmt: skip
+        self.carried.t = t
+        self.carried.rows = [r for p in parts if p["carried"][0] == t for r in p["carried"][1]]
+        self.dirty = True
+
     def _build(self):
         b, m = self.balls, self.members
-        old = self._pairs if self.set is not None else {}
-        self.keys = [(i, -1) for i in m] + [
-            (min(i, j), max(i, j)) for a, i in enumerate(m) for j in m[a + 1 :]
-        ]
+        old = self._pairs
+        self.keys = [(i, -1) for i in m] + self._ball_pairs(old)
         local = {i: q for q, i in enumerate(m)}
         pairs = [(local[i], -1 if j < 0 else local[j]) for i, j in self.keys]
         laws = [b.table.law(i, PLATE if j < 0 else j) for i, j in self.keys]
@@ -176,15 +210,37 @@ class ActiveMembers:
             settle_energy=np.array(settle), rtol=self.rtol, **modal,
         )  # fmt: skip
         self.index = {k: p for p, k in enumerate(self.keys)}
+        self.pairs_of = {}  # ball -> its pairs, in the set's order
+        for p, (i, j) in enumerate(self.keys):
+            self.pairs_of.setdefault(i, []).append(p)
+            if j >= 0:
+                self.pairs_of.setdefault(j, []).append(p)
         for k, p in self.index.items():
             if k in old:
                 s.contacts.put(p, old[k])
         s.h = self.h
         self.local = local
-        if old:
+        if old or self.carried.rows:
             self.carried.restore(s, local, self.index)
         self.dirty = False
         self.totals["rebuilds"] += 1
+
+    def _ball_pairs(self, old) -> list:
+        """The ball-ball pair keys the set watches: every pair of members, or those in
+        ``watch`` and those touching (``old``: the pair states by key)."""
+        m = self.members
+        keys = [(min(i, j), max(i, j)) for a, i in enumerate(m) for j in m[a + 1 :]]
+        if self.watch is None:
+            return keys
+        return [k for k in keys if k in self.watch or (k in old and old[k][0])]
+
+    def rewatch(self, watch) -> None:
+        """Watch only the ball pairs in ``watch`` (a set of keys (i, j), i < j, that holds
+        every pair of members that can touch until the caller says otherwise; None: every
+        pair): the set is rebuilt on its next use."""
+        self._sync()
+        self.watch = watch
+        self.dirty = True
 
     def _plate_friction(self, modal) -> dict:
         """With friction on the modal plate: what the friction table of a set rebuilt with the
@@ -230,9 +286,40 @@ class ActiveMembers:
         t : float
             The time reached (s).
         """
+        return self.report(self.advance(t, t_stop))
+
+    def advance(self, t: float, t_stop: float):
+        """Integrate the members from t to t_stop (s) or their first event, keeping the force
+        rows and kinks in the set (``report`` takes them; ``restore`` drops them): the
+        set's ``Outcome``."""
         s = self._ready()
         out = s.advance(t, t_stop, self.h or None)
         self.h = s.h
+        return out
+
+    def snapshot(self) -> tuple:
+        """What ``advance`` changes, for ``restore`` (the built set's ``snapshot``)."""
+        return self._ready().snapshot(), self.h
+
+    def restore(self, snap) -> int:
+        """Undo the ``advance`` calls since ``snapshot`` (their steps stay counted); returns
+        the steps undone."""
+        steps = self.set.stats
+        self.set.restore(snap[0])
+        self.h = snap[1]
+        for name, key in (
+            ("steps", "kernel_steps"),
+            ("attempts", "kernel_attempts"),
+            ("nfev", "kernel_nfev"),
+            ("found_again", "events_found_again"),
+        ):
+            self.totals[key] += steps[name] - self.set.stats[name]  # fmt: skip
+        return steps["steps"] - self.set.stats["steps"]
+
+    def report(self, out):
+        """Take the force rows and kinks of the calls since the last report and translate
+        ``out`` (an ``Outcome``) as ``next_event`` returns it."""
+        s = self.set
         self.forces.drain(s, self.keys, self.local)
         self.kinks = [(t_k, kind, self.keys[p]) for t_k, kind, p in s.kink_log()]
         s.clear_outputs()
@@ -306,7 +393,7 @@ class ActiveMembers:
         """Keys of member i's pairs in contact now."""
         s = self._ready()
         touching = s.contacts.touching
-        return [k for k, p in self.index.items() if i in k[:1] + k[1:] and touching[p]]
+        return [self.keys[p] for p in self.pairs_of.get(i, ()) if touching[p]]
 
     # --- contacts ---------------------------------------------------------------------------
     def start_contact(self, key):

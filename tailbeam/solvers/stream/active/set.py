@@ -292,6 +292,25 @@ class ActiveSet:
         self.h = float(tio[1])
         return io.outcome(float(tio[0]))
 
+    def snapshot(self) -> tuple:
+        """What ``advance`` changes (state, contact states, integer outputs and counters,
+        fresh rows, next step), for ``restore``: a call undone (an island of the driver's
+        active set advanced past another island's event, ``islands``)."""
+        io = self.io
+        return (self.y.copy(), tuple(a.copy() for a in self.contacts.arrays()),
+                io.iout.copy(), io.fresh.copy(), io.t_fresh, self.h)  # fmt: skip
+
+    def restore(self, snap) -> None:
+        """Put back what ``snapshot`` kept (in place: the views of ``y`` stay valid; the
+        force rows and kinks written since are dropped with the counts in ``iout``)."""
+        y, contacts, iout, fresh, t_fresh, h = snap
+        self.y[:] = y
+        for a, b in zip(self.contacts.arrays(), contacts, strict=True):
+            a[...] = b
+        self.io.iout[:] = iout
+        self.io.fresh[:] = fresh
+        self.io.t_fresh, self.h = t_fresh, h
+
     # --- the results of the calls so far (kept in ``io``) ----------------------------------
     def force_rows(self) -> np.ndarray:
         """(R, 3) rows (t s, pair, F N) of the plate forces written so far."""

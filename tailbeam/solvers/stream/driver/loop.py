@@ -6,7 +6,9 @@ the candidate pairs of the current epoch (``broadphase``, certified over the epo
 touch of two balls (``heap_events`` handles them). The balls in contact, and every ball that
 could reach one of them within the set's horizon, form the ACTIVE SET (``membership``),
 integrated by the compiled kernel (``tailbeam.solvers.stream.active``: DOP853, every kink an
-event) up to the next heap event, its horizon or its own next event (``set_events``). Work is
+event) up to the next heap event, its horizon or its own next event (``set_events``); with
+friction on the rigid plate as islands that cannot touch within the horizon, each with its
+own step (``tailbeam.solvers.stream.active.islands``). Work is
 therefore spent per contact and per event, never per ball per step; memory holds the
 records, not the trajectories.
 
@@ -39,6 +41,7 @@ from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.progress import note, quiet, task
 from tailbeam.solvers.stream.active.friction_pairs import FrictionPairs
+from tailbeam.solvers.stream.active.islands import Islands
 from tailbeam.solvers.stream.active.members import ActiveMembers
 from tailbeam.solvers.stream.driver.balls import GONE, PENDING, SLIDE, Balls
 from tailbeam.solvers.stream.driver.clock import Clock
@@ -60,6 +63,8 @@ GRAZING_RETRIES = 2  # runs again at rtol / 10, / 100 after a stall at one insta
 # safety net (the kernel does not find an event again at the instant it applied it)
 WORK_CHECK_EVERY = 16  # loop rounds between two checks of the work bound
 STUCK_LIMIT = 5_000  # loop rounds without time moving before the run is stopped
+_ISLANDS = True  # with friction on the rigid plate: the active set as islands (``islands``);
+# a private switch (False: one set, as on the modal plate) for comparisons
 
 
 @dataclass
@@ -276,8 +281,11 @@ class _Stream:
         def settle_energy(i: int) -> float:
             return 0.5 * balls.mass[i] * rest_speed**2
 
-        self.act = act = ActiveMembers(balls, rtol, settle_energy, plate,
-                                       lambda: balls.resting(clock.t), pairs)  # fmt: skip
+        if pairs is not None and plate is None and _ISLANDS:  # each island its own step
+            self.act = act = Islands(balls, rtol, settle_energy, pairs)
+        else:
+            self.act = act = ActiveMembers(balls, rtol, settle_energy, plate,
+                                           lambda: balls.resting(clock.t), pairs)  # fmt: skip
         self.ledger = EnergyLedger(balls, act, clock.stats)
         self.records = ContactRecords(balls, act, clock, rest_speed)
         self.loads = PlateLoads(balls, act.forces)
