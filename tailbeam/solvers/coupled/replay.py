@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tailbeam.signals.sensor import measure
+from tailbeam.signals.sensor import SensorSpec, measure
 from tailbeam.solvers.plate_loads.propagator import replay
 from tailbeam.solvers.plate_loads.readings import Readings
 
@@ -93,6 +93,7 @@ class ModalReplay:
     contact_points: tuple = ()
     residual_flexibility: bool = False
     _cross: dict = field(default_factory=dict, repr=False)  # residual cross compliances
+    _readings: dict = field(default_factory=dict, repr=False)  # plain points on a structure
 
     def modal_sample(self, times):
         """(q, q', q'') of every mode at ``times`` (s), each (n_modes, len(times)); exact."""
@@ -159,7 +160,8 @@ class ModalReplay:
         """The truncated modes' quasi-static (mode-acceleration) response at points (p, 2) m:
         w = -G_res F(t) (F pushes the plate down), G_res the residual cross compliance between
         the ball's contact and each point (ModalBasis.residual_cross_compliance, with the
-        contact's load model).
+        contact's load model; on a structure ``Readings.residual_cross`` of the points as
+        plain channels, from the cached sensor influences).
         v and a are its central differences over +-h: h is the spacing of uniform ``times``
         (so a sampled record is the exact second difference of the sampled force: gain
         sinc^2(f h), no aliasing of the force's kinks), else 1/(8 f_top). Arrays (p, len).
@@ -197,8 +199,24 @@ class ModalReplay:
     def _cross_compliance(self, x, y, r, points):
         key = (x, y, r, points.tobytes())
         if key not in self._cross:
-            self._cross[key] = self.basis.residual_cross_compliance((x, y), points, r)
+            if getattr(self.basis, "model", None) is None:
+                cross = self.basis.residual_cross_compliance((x, y), points, r)
+            else:
+                cross = self._point_readings(points).residual_cross((x, y), r)
+            self._cross[key] = cross
         return self._cross[key]
+
+    def _point_readings(self, points):
+        """The plain points (p, 2) m of a structure's impact face as channels (``Readings``):
+        their static part from the sensor influences cached beside the basis, so a run whose
+        points were solved before factorises nothing for them."""
+        key = points.tobytes()
+        if key not in self._readings:
+            plain = [
+                SensorSpec(f"points[{i}]", (float(x), float(y))) for i, (x, y) in enumerate(points)
+            ]
+            self._readings[key] = Readings(self.basis, plain)
+        return self._readings[key]
 
     def energy(self, times) -> np.ndarray:
         """Vibration energy of the plate's kept modes, J, at ``times``."""
