@@ -6,6 +6,7 @@ shapes, a sinusoid's RMS and Parseval), never from the plotting code.
 
 import csv
 import io
+import warnings
 
 import numpy as np
 import pytest
@@ -218,3 +219,20 @@ def test_scenario_figures_have_nothing_cut_off(material):
         page = fig.bbox_inches
         assert drawn.x0 >= page.x0 and drawn.x1 <= page.x1, fig.texts
         assert drawn.y0 >= page.y0 and drawn.y1 <= page.y1, fig.texts
+
+
+def test_sensor_figure_of_a_zero_record_says_so_without_a_warning(tmp_path):
+    """A sensor that read nothing (no impact in the run): its spectra cannot be drawn on a log
+    axis; the figure draws them flat, says so, and raises no warning."""
+    out = sine_output()
+    zero_a = np.zeros_like(out.t)
+    freq, amp = amplitude_spectrum(zero_a, out.chain.sample_rate)
+    zero = SensorOutput("s1", out.t, zero_a, freq, amp, out.chain)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = build_sensor_figure(zero)
+        fig.savefig(tmp_path / "zero.png")
+    _time, spectrum, welch, spectrogram = fig.axes[:4]
+    for ax in (spectrum, welch, spectrogram):
+        assert "zero throughout" in [t.get_text() for t in ax.texts]
+    assert spectrum.get_yscale() == welch.get_yscale() == "linear"

@@ -16,7 +16,15 @@ PACKAGE = Path(__file__).resolve().parents[1] / "tailbeam"
 # longest prefix of its dotted name (the package itself, ``tailbeam``, names only its
 # ``__init__``).
 LEVELS = (
-    {"ground": ("tailbeam._version", "tailbeam.errors", "tailbeam.progress", "tailbeam.cachedir", "tailbeam.jit")},
+    {
+        "ground": (
+            "tailbeam._version",
+            "tailbeam.errors",
+            "tailbeam.progress",
+            "tailbeam.cachedir",
+            "tailbeam.jit",
+        )
+    },
     {"physics": ("tailbeam.physics",)},
     {"plate": ("tailbeam.plate",), "signals": ("tailbeam.signals",)},
     {"streams": ("tailbeam.streams",)},

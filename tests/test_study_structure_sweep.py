@@ -19,6 +19,7 @@ from solid_meshes import box_mesh  # noqa: E402
 from tailbeam.cli import main  # noqa: E402
 from tailbeam.io.scene_file import loads_scene  # noqa: E402
 from tailbeam.plate.solid.cached import MATRICES_PREFIX, MESH_PREFIX, STATIC_PREFIX  # noqa: E402
+from tailbeam.plate.solid.face.influence import PREFIX as INFLUENCE_PREFIX  # noqa: E402
 from tailbeam.simulation import simulate  # noqa: E402
 
 LENGTH, WIDTH = 0.4, 0.2
@@ -121,8 +122,9 @@ def test_each_case_runs_on_the_structure_of_its_values(swept, meshes, tmp_path):
     assert code == 0
     # one basis per stiffness and mesh, solved in the warm-up and cached (beside each, its
     # impact face's static compliance, structure-face-compliance-*.npz; the mesh as read and
-    # K's nonzero count, structure-mesh-*.npz and structure-matrices-*.npz)
-    others = (STATIC_PREFIX, MESH_PREFIX, MATRICES_PREFIX)
+    # K's nonzero count, structure-mesh-*.npz and structure-matrices-*.npz; the sensors' static
+    # influences, structure-sensor-influence-*.npz)
+    others = (STATIC_PREFIX, MESH_PREFIX, MATRICES_PREFIX, INFLUENCE_PREFIX)
     bases = [p for p in cache.glob("structure-*.npz") if not p.name.startswith(others)]
     assert len(bases) == 4
     ds = xr.open_zarr(out / "dataset.zarr")

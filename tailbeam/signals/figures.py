@@ -97,10 +97,26 @@ def _time_panel(ax, output, stats):
     )
 
 
+def _log_curve(ax, x, y, floor, **style):
+    """``y`` against ``x`` on a log axis, cut at ``floor`` times its largest value; a record
+    that is zero throughout is drawn flat on a linear axis and said so."""
+    top = float(np.max(y)) if len(y) else 0.0
+    if top > 0.0:
+        ax.semilogy(x, np.maximum(y, top * floor), **style)
+        return
+    ax.plot(x, np.zeros_like(x), **style)
+    _say_zero(ax)
+
+
+def _say_zero(ax):
+    """Write on ``ax`` that the record is zero throughout (nothing to scale a log axis by)."""
+    ax.text(0.5, 0.75, "zero throughout", transform=ax.transAxes, ha="center", va="center")
+
+
 def _spectrum_panel(ax, output, stats, f_max):
     keep = output.freq <= f_max
     amp = output.amplitude[keep]
-    ax.semilogy(output.freq[keep] / 1e3, np.maximum(amp, amp.max() * 1e-9), lw=0.6)
+    _log_curve(ax, output.freq[keep] / 1e3, amp, 1e-9, lw=0.6)
     ax.set_xlim(0.0, f_max / 1e3)
     ax.set_xlabel("frequency (kHz)")
     ax.set_ylabel("amplitude (m/s$^2$, peak)")
@@ -114,7 +130,7 @@ def _welch_panel(ax, output, stats, f_max):
     fs = output.chain.sample_rate
     f, p = welch_psd(output, stats.welch_segment)
     keep = f <= f_max
-    ax.semilogy(f[keep] / 1e3, np.maximum(p[keep], p[keep].max() * 1e-12), lw=0.8, color="C2")
+    _log_curve(ax, f[keep] / 1e3, p[keep], 1e-12, lw=0.8, color="C2")
     ax.set_xlim(0.0, f_max / 1e3)
     ax.set_xlabel("frequency (kHz)")
     ax.set_ylabel("PSD ((m/s$^2$)$^2$/Hz)")
@@ -140,6 +156,8 @@ def _spectrogram_panel(fig, ax, output, stats, f_max):
         t * scale, f[keep] / 1e3, db, shading="nearest", cmap="magma", vmin=top - DB_RANGE, vmax=top
     )
     fig.colorbar(mesh, ax=ax, label="PSD (dB re 1 (m/s$^2$)$^2$/Hz)")
+    if not s.max() > 0.0:
+        _say_zero(ax)
     ax.set_xlim(0.0, stats.duration * scale)
     ax.set_ylim(0.0, f_max / 1e3)
     ax.set_xlabel(f"time t ({unit})")
