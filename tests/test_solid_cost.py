@@ -19,7 +19,7 @@ from tailbeam.plate.solid import Support, assemble_structure
 from tailbeam.plate.solid import cost as C
 from tailbeam.plate.solid import modes as solid_modes
 from tailbeam.plate.solid.factor import factorize
-from tailbeam.simulation import choose_solver
+from tailbeam.simulation import choose_solver, simulate
 from tailbeam.solvers.modal_setup.plan import plan_bases
 from tailbeam.solvers.run_cost import estimate_run
 
@@ -166,3 +166,23 @@ def test_a_three_axis_sensor_costs_as_three_sensors(tmp_path, monkeypatch):
         costs.append(estimate_run(scene, choose_solver(scene, "auto")))
     for part in ("sensor replay", "writing"):
         assert costs[0].part(part).time_s == costs[1].part(part).time_s
+
+
+def test_the_static_set_up_is_costed_as_cached_once_the_run_cached_it(tmp_path, monkeypatch):
+    """The set-up part is one factorisation of K until a run has left the impact face's
+    compliance and every sensor channel's influence in the cache; then it is their reading
+    (no time). A sensor the cache has not seen brings the factorisation back."""
+    plate_mesh(str(tmp_path / "plate.msh"), divisions=12)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("TAILBEAM_CACHE_DIR", str(tmp_path / "cache"))
+    one = '[[sensors]]\nname = "S1"\nposition = [-0.1, 0.05]\nsample_rate = 25600.0\n'
+    two = one + '[[sensors]]\nname = "S2"\nposition = [0.1, -0.05]\nsample_rate = 25600.0\n'
+    scene = loads_scene(STRUCTURE_SCENE + one)
+    solver = choose_solver(scene, "auto")
+    before = estimate_run(scene, solver).part("set-up")
+    assert not before.cached and before.time_s > 0 and "factorisation" in before.driver
+    assert simulate(scene, progress=False).sensor_outputs  # solves, caches the static parts
+    after = estimate_run(scene, solver).part("set-up")
+    assert after.cached and after.time_s == 0.0
+    scene_two = loads_scene(STRUCTURE_SCENE + two)
+    assert not estimate_run(scene_two, choose_solver(scene_two, "auto")).part("set-up").cached

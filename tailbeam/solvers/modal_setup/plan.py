@@ -24,6 +24,7 @@ from tailbeam.plate.fe.modes import _estimated_count
 from tailbeam.plate.fe.resolution import resolve
 from tailbeam.plate.solid import cached as cached_structure
 from tailbeam.plate.solid.cost import structure_cost
+from tailbeam.plate.solid.face import influence
 from tailbeam.plate.solid.held import held_structure
 from tailbeam.scene import ModalPlateSettings
 from tailbeam.solvers.cost import Part, eigen_part, setup_part, stream_setup_part
@@ -113,10 +114,23 @@ def _structure_plan(scene, settings, band: dict) -> BasisPlan:
     else:  # the file holds the (n_dofs, modes) float64 vectors
         modes = max(1, int(size // (8 * model.n_dofs)))
         eigen = eigen_part("eigen-solve", model.n_dofs, modes, size, driver + ", cached")
-    static = Part("set-up", cost.factorise_s, cost.memory_bytes,
-                  "the static compliance: one factorisation")  # fmt: skip
+    static = _static_part(model, scene, cost)
     return BasisPlan((eigen, static), modes, fmax, settings.coupling == "two-way", 0, "",
                      model.n_dofs, 0)  # fmt: skip
+
+
+def _static_part(model, scene, cost) -> Part:
+    """The structure's static compliances: read from the cache when it holds the impact
+    face's (``structure-face-compliance``) and every sensor channel's influence, else one
+    factorisation of K."""
+    folder = modal_cache.default_cache_dir()
+    key = cached_structure.static_key(model)
+    face = modal_cache.entry_path(folder, cached_structure.STATIC_PREFIX, key).is_file()
+    channels = [c for s in scene.sensors for c in s.channels()]
+    if face and influence.all_cached(model, channels, folder):
+        return Part("set-up", 0.0, 0.0, "the static compliances, cached", cached=True)
+    return Part("set-up", cost.factorise_s, cost.memory_bytes,
+                "the static compliance: one factorisation")  # fmt: skip
 
 
 def _ritz_points(scene, settings, theory: str) -> int:

@@ -25,7 +25,7 @@ import numpy as np
 
 from tailbeam.physics.contact_patch import disc_rule
 from tailbeam.plate.slopes import values_and_slopes
-from tailbeam.plate.solid.face.influence import FaceInfluence
+from tailbeam.plate.solid.face.influence import FaceInfluence, channel_points
 
 
 class Readings:
@@ -48,12 +48,7 @@ class Readings:
 
     def _points_directions(self):
         """(p, 3) m points and (p, 3) unit directions of the channels."""
-        pts, dirs = [], []
-        for c in self.channels:
-            xyz = tuple(c.position) + (0.0,) * (3 - len(c.position))
-            pts.append(xyz)
-            dirs.append(c.direction if c.direction is not None else (0.0, 0.0, 1.0))
-        return np.array(pts, dtype=float), np.array(dirs, dtype=float)
+        return channel_points(self.channels)
 
     def _operator(self):
         """(p, n_dofs) sparse: the structure's displacement at the channels."""

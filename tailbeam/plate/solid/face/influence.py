@@ -24,6 +24,27 @@ from tailbeam.progress import note
 PREFIX = "structure-sensor-influence"
 
 
+def channel_points(channels) -> tuple:
+    """(p, 3) m points and (p, 3) unit directions of single-direction sensor channels
+    (``SensorSpec.channels``): a 2-D position lies on the impact face (z = 0); no direction
+    reads along +z."""
+    pts, dirs = [], []
+    for c in channels:
+        pts.append(tuple(c.position) + (0.0,) * (3 - len(c.position)))
+        dirs.append(c.direction if c.direction is not None else (0.0, 0.0, 1.0))
+    return np.array(pts, dtype=float).reshape(-1, 3), np.array(dirs, dtype=float).reshape(-1, 3)
+
+
+def all_cached(model, channels, cache_dir=None) -> bool:
+    """Whether the cache folder (default: tailbeam's) holds the influence of every channel
+    of ``channels`` on ``model``: then no run needs to factorise K for them."""
+    folder = cache_dir or disk.default_cache_dir()
+    key = static_key(model)
+    points, directions = channel_points(channels)
+    return all(disk.entry_path(folder, PREFIX, influence_key(model, x, d, key)).is_file()
+               for x, d in zip(points, directions, strict=True))  # fmt: skip
+
+
 def influence_key(model, point, direction, structure_key=None) -> str:
     """Hex key of the influence vector of the channel at surface ``point`` (3,) m along the
     unit ``direction`` (3,) on ``model`` (a StructureModel); ``structure_key``: its
@@ -108,4 +129,4 @@ def _store(where, vector, point, direction) -> None:
         pass
 
 
-__all__ = ["FaceInfluence", "influence_key"]
+__all__ = ["FaceInfluence", "all_cached", "channel_points", "influence_key"]
