@@ -6,14 +6,10 @@ a helper called with ``0`` in one place and with a variable ``i`` in another is 
 twice, and an event helper called with ``EventCode`` members and with plain integers up to
 four times. Functions decorated here are typed with the plain types (``int64``, ``bool``)
 when compiled code calls them, so one copy serves every call. On a fresh cache this cuts the
-rigid kernel's first compilation by a third to a half and the stream kernel's by a quarter
-(16 to 11 s and 64 to 48 s of wall time on an idle machine, ``tools/time_revisions.py``);
-results are unchanged (the same operations on the path taken).
-
-The coupled kernel's event helpers (``tailbeam.solvers.coupled.kernel``) keep numba's
-typing by value (``njit_typed_by_value``): typed plainly, they compile in two thirds of the
-time but the coupled solver then runs about 15 % slower (``tools/time_revisions.py --solver
-coupled``), and a single-ball sweep runs that solver thousands of times.
+first compilation of the rigid, stream and coupled kernels by a quarter to a third (16 to
+11 s, 64 to 48 s and 73 to 49 s of wall time at a load of 1, ``tools/time_revisions.py``);
+results are unchanged (the same operations on the path taken) and so is the run time
+within the machine's noise.
 
 A function whose body needs a constant argument (for example to index a heterogeneous
 tuple) still gets it: if the plain types do not compile, numba's own typing is used.
@@ -22,9 +18,7 @@ tuple) still gets it: if the plain types do not compile, numba's own typing is u
 from numba import njit as _numba_njit
 from numba.core import errors, types
 
-__all__ = ["njit", "njit_typed_by_value"]
-
-njit_typed_by_value = _numba_njit  # numba's own: one copy per constant's and enum's type
+__all__ = ["njit"]
 
 
 def njit(function=None, **options):

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from tailbeam.jit import njit_typed_by_value
+from tailbeam.jit import njit
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.coupled.step import CLAMPED, CONTACT, FLIGHT, solve_step
 from tailbeam.solvers.numerics.jit import helper_njit
@@ -31,7 +31,7 @@ ST_STOP, ST_EVENT, ST_FULL, ST_FAIL, ST_STEPS = range(5)
 MAX_HALVINGS = 30  # of a step whose contact forces are not solved (tau / 1e9)
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def _bounds(ctx, st, f0m, f1m, tau, g):
     """Per-ball bounds over a step of tau: L >= |gap'| and A >= |plate acceleration|."""
     omega, zeta, phi, _c, _m, _r, _k, _e, _cc, _d, _cl = ctx
@@ -54,7 +54,7 @@ def _bounds(ctx, st, f0m, f1m, tau, g):
     return L, A
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def _event_value(kind, b, aux, d):
     if kind == EventCode.CONTACT_START:
         return -aux[0, b]  # gap
@@ -79,10 +79,10 @@ def _alloc(nb, n):
     )
 
 
-_alloc = njit_typed_by_value(cache=True)(_alloc)
+_alloc = njit(cache=True)(_alloc)
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def _copy_out(src, dst):
     dst[0][:] = src[0]
     dst[1][:] = src[1]
@@ -95,7 +95,7 @@ def _copy_out(src, dst):
     dst[8][:] = src[8]
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def _locate(kind, b, lo, flo, hi, fhi, ctx, st, out, g, d, guess):
     """Shrink [lo, hi] (f(lo) > 0 > f(hi) up to sign) around the event; returns hi.
 
@@ -131,7 +131,7 @@ def _locate(kind, b, lo, flo, hi, fhi, ctx, st, out, g, d, guess):
     return hi
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def _certify(b, tau, ctx, st, out, g, L, A, gap0, rate0, guess):
     """Earliest (lo, hi, f(lo), f(hi)) bracket of a contact start of flying ball b in (0, tau],
     or lo = -1 if the gap is certified positive on the whole step (bisection with bounds)."""
@@ -200,7 +200,7 @@ def _pending_event(F, mode, deep, cur, d, clampf):
     return EventCode.NONE, -1
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def _flight_step(ctx, st, remaining, h, g, fm):
     """Step (s) with no ball in contact: the certified horizon before any flying ball can
     touch (from the bounds of ``_bounds`` on the gap), at least its h, at most remaining."""
@@ -270,7 +270,7 @@ def _contact_kinds(b, mode, deep, aux, d, clampf, kinds):
     return nk
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def _keep(hit, kd, b, best, kind_best, b_best, out2, out_best):
     """Keep event kd of ball b at hit (s) (solution in out2) if it is the earliest so far."""
     if hit < best or kind_best == EventCode.NONE:
@@ -279,7 +279,7 @@ def _keep(hit, kd, b, best, kind_best, b_best, out2, out_best):
     return best, kind_best, b_best
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def _ball_events(b, tau, ctx, st, aux, out2, out_best, g, L, A, guess, best, kind_best, b_best,
                  mode, cur, d, kinds, nk):  # fmt: skip
     """Locate the events of ball b in the step of tau (s) (touching: the nk kinds found by
@@ -367,7 +367,7 @@ def _apply_event(kind, b, F, mode, deep, cur, hist, d):
         hist[1, b] = 0.0
 
 
-@njit_typed_by_value(cache=True)
+@njit(cache=True)
 def run(ctx, st, t, t_stop, h, max_steps, g, bufs, nbuf, evout):
     """Step from t until t_stop, the first event, a full buffer or max_steps.
 
