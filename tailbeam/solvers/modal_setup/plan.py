@@ -127,7 +127,7 @@ def _static_part(model, scene, cost) -> Part:
     key = cached_structure.static_key(model)
     face = modal_cache.entry_path(folder, cached_structure.STATIC_PREFIX, key).is_file()
     channels = [c for s in scene.sensors for c in s.channels()]
-    if face and influence.all_cached(model, channels, folder):
+    if face and influence.all_cached(model, channels, folder, key):
         return Part("set-up", 0.0, 0.0, "the static compliances, cached", cached=True)
     return Part("set-up", cost.factorise_s, cost.memory_bytes,
                 "the static compliance: one factorisation")  # fmt: skip

@@ -35,11 +35,12 @@ def channel_points(channels) -> tuple:
     return np.array(pts, dtype=float).reshape(-1, 3), np.array(dirs, dtype=float).reshape(-1, 3)
 
 
-def all_cached(model, channels, cache_dir=None) -> bool:
+def all_cached(model, channels, cache_dir=None, structure_key=None) -> bool:
     """Whether the cache folder (default: tailbeam's) holds the influence of every channel
-    of ``channels`` on ``model``: then no run needs to factorise K for them."""
+    of ``channels`` on ``model``: then no run needs to factorise K for them.
+    ``structure_key``: the model's ``static_key`` when known."""
     folder = cache_dir or disk.default_cache_dir()
-    key = static_key(model)
+    key = structure_key or static_key(model)
     points, directions = channel_points(channels)
     return all(disk.entry_path(folder, PREFIX, influence_key(model, x, d, key)).is_file()
                for x, d in zip(points, directions, strict=True))  # fmt: skip
