@@ -39,7 +39,7 @@ from tailbeam.physics.incline import InclinedPlate
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.rigid.model import make_pairs
 from tailbeam.solvers.rigid.solver import _KernelIntegrator
-from tailbeam.solvers.stream.active.set import ActiveSet
+from tailbeam.solvers.stream.active.integrator.set import ActiveSet
 
 RADIUS, SPEED = 0.03, 2.0
 

@@ -32,7 +32,7 @@ from tailbeam.physics.contact_law import ball_plate_law
 from tailbeam.physics.materials import SANDSTONE
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.solvers.coupled import simulate_coupled
-from tailbeam.solvers.stream.active.set import ActiveSet
+from tailbeam.solvers.stream.active.integrator.set import ActiveSet
 
 RADIUS, SPEED, G, ZETA, XY = 0.03, 2.0, 9.81, 0.01, (0.07, -0.05)
 PLATE = Plate()

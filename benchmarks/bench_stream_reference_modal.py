@@ -42,7 +42,7 @@ from test_stream_solver import _particles, _worst_difference  # noqa: E402
 from tailbeam.physics.bodies import Plate  # noqa: E402
 from tailbeam.physics.incline import InclinedPlate  # noqa: E402
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis  # noqa: E402
-from tailbeam.solvers.stream.active import shapes as active_shapes  # noqa: E402
+from tailbeam.solvers.stream.active.plate import shapes as active_shapes  # noqa: E402
 from tailbeam.solvers.stream.driver import loop as stream  # noqa: E402
 from tailbeam.solvers.stream.driver import membership as stream_membership  # noqa: E402
 from tailbeam.solvers.stream.plate import StreamPlate  # noqa: E402

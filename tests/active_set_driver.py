@@ -10,7 +10,7 @@ import numpy as np
 from tailbeam.physics.incline import EDGES
 from tailbeam.physics.pair import pair_kinematics, plate_foot
 from tailbeam.results.records import PLATE, EventCode, Impact, LeaveEvent
-from tailbeam.solvers.stream.active.set import ActiveSet
+from tailbeam.solvers.stream.active.integrator.set import ActiveSet
 
 
 def reference_pairs(n):

@@ -1,8 +1,8 @@
-"""The compiled active-set integrator (tailbeam.solvers.stream.active.set) against independent
-truths: the rigid-plate solver (tailbeam.solvers.rigid, its own 1-D kernel), Johnson's Hertz closed
-forms (tailbeam.physics.hertz), conservation laws, the closed-form slide on the frictionless
-incline, and the slow scipy stream reference (tailbeam.solvers.stream.reference.solver) on the
-shared scenes.
+"""The compiled active-set integrator (tailbeam.solvers.stream.active.integrator.set) against
+independent truths: the rigid-plate solver (tailbeam.solvers.rigid, its own 1-D kernel),
+Johnson's Hertz closed forms (tailbeam.physics.hertz), conservation laws, the closed-form
+slide on the frictionless incline, and the slow scipy stream reference
+(tailbeam.solvers.stream.reference.solver) on the shared scenes.
 
 Tolerances are the brief's (1e-10 vs the rigid solver, 1e-8 Hertz, 1e-12 momentum, 1e-9
 energy, 1e-6 vs the reference); the measured values are in the docstrings.
@@ -23,7 +23,7 @@ from tailbeam.results.records import EventCode
 from tailbeam.solvers.numerics import chebyshev as cheb_events
 from tailbeam.solvers.numerics import step_events
 from tailbeam.solvers.rigid import simulate_rigid
-from tailbeam.solvers.stream.active.set import ActiveSet
+from tailbeam.solvers.stream.active.integrator.set import ActiveSet
 
 NO_GRAVITY = InclinedPlate(gravity=0.0)
 

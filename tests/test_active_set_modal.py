@@ -20,7 +20,7 @@ from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.coupled import simulate_coupled
 from tailbeam.solvers.plate_loads import propagator
-from tailbeam.solvers.stream.active.set import ActiveSet
+from tailbeam.solvers.stream.active.integrator.set import ActiveSet
 
 R = 0.03
 G = 9.81

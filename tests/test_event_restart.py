@@ -20,8 +20,8 @@ from tailbeam.physics.contacts import LawOptions, contact_table
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.stream.active.compiled.pairs import R_CONTACT
+from tailbeam.solvers.stream.active.integrator.set import ActiveSet
 from tailbeam.solvers.stream.active.members import ActiveMembers
-from tailbeam.solvers.stream.active.set import ActiveSet
 from tailbeam.solvers.stream.driver.balls import Balls
 from tailbeam.streams.generator import Particle
 

@@ -1,5 +1,5 @@
-"""Thinning the plate force histories of a run with friction (``active.thinning``, used by
-``active.forces``): the kept history is within the tolerance of every dropped node (checked
+"""Thinning the plate force histories of a run with friction (``active.plate.thinning``, used by
+``active.plate.forces``): the kept history is within the tolerance of every dropped node (checked
 by interpolating through the kept nodes, numpy's ``interp``), jumps and ends are kept; on the
 modal plate the sensors' replay of the thinned loads agrees with that of every node written.
 """
@@ -13,8 +13,9 @@ from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import COAL
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
 from tailbeam.solvers.plate_loads.response import LoadResponse
-from tailbeam.solvers.stream.active import forces, members
-from tailbeam.solvers.stream.active.thinning import keep_nodes
+from tailbeam.solvers.stream.active import members
+from tailbeam.solvers.stream.active.plate import forces
+from tailbeam.solvers.stream.active.plate.thinning import keep_nodes
 from tailbeam.solvers.stream.driver.loop import solve_stream
 from tailbeam.solvers.stream.plate import StreamPlate
 from tailbeam.streams.generator import Particle, default_label

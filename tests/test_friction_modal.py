@@ -10,7 +10,7 @@
   with frozen shapes (the fast solver's contact model: shapes and their gradients kept per
   contact, tests/test_stream_reference_modal.py), both at rtol 1e-11, on a scene where the
   fast solver's shapes are those at the touch (see ``ten_balls``); the sensors' load
-  replay (the contact forces and friction's couples, ``active.forces``) reproduces the
+  replay (the contact forces and friction's couples, ``active.plate.forces``) reproduces the
   plate's modal state;
 - energy: c = 0 and undamped modes, balls + rotation + modes + contacts + friction's
   dissipation conserved (a conservation law); leaving the moment out breaks it.

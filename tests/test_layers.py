@@ -150,6 +150,23 @@ def test_the_layers_import_only_downwards():
     assert upward_imports(graph) == []
 
 
+# The active set's own layers: the compiled kernel at the bottom, its Python wrapper and the
+# plate side of its pairs beside each other above it, the driver's view (``members``,
+# ``islands``, ...) on top.
+ACTIVE = "tailbeam.solvers.stream.active"
+ACTIVE_LEVELS = (
+    {"compiled": (f"{ACTIVE}.compiled",)},
+    {"integrator": (f"{ACTIVE}.integrator",), "plate": (f"{ACTIVE}.plate",)},
+    {"members": (ACTIVE,)},
+)
+
+
+def test_the_active_set_imports_only_downwards():
+    graph = import_graph(PACKAGE)
+    assert graph[f"{ACTIVE}.members"] >= {f"{ACTIVE}.integrator.set", f"{ACTIVE}.plate.pairs"}
+    assert upward_imports(graph, ACTIVE_LEVELS) == []
+
+
 def test_no_import_cycle_at_any_depth():
     assert find_cycle(import_graph(PACKAGE)) == []
 

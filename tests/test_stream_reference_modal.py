@@ -25,7 +25,7 @@ from tailbeam.physics.bodies import Plate
 from tailbeam.physics.incline import InclinedPlate
 from tailbeam.physics.materials import CARBON_STEEL
 from tailbeam.plate.closed_forms import ssss_kirchhoff_basis
-from tailbeam.solvers.stream.active import shapes as active_shapes
+from tailbeam.solvers.stream.active.plate import shapes as active_shapes
 from tailbeam.solvers.stream.driver import loop as stream
 from tailbeam.solvers.stream.driver import membership as stream_membership
 from tailbeam.solvers.stream.plate import StreamPlate

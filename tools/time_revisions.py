@@ -126,7 +126,10 @@ def resting_set(n, all_pairs):
 
     InclinedPlate = from_either("InclinedPlate", "tailbeam.physics.incline")
     ActiveSet = from_either(
-        "ActiveSet", "tailbeam.solvers.stream.active.set", "tailbeam.solvers.stream.active_set"
+        "ActiveSet",
+        "tailbeam.solvers.stream.active.integrator.set",
+        "tailbeam.solvers.stream.active.set",
+        "tailbeam.solvers.stream.active_set",
     )
     radius = 0.03
     incline = InclinedPlate(inclination=15.0)

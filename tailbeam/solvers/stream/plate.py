@@ -4,7 +4,7 @@ The modes q, q' (mass-normalised, ``tailbeam.plate.basis.ModalBasis``) live here
 contact is integrated, advanced exactly (``tailbeam.solvers.plate_loads.propagator``) under the
 dead loads of the balls resting on the plate (constant modal forces -sum phi(x_i, y_i) m_i g
 cos theta, refreshed whenever the modes are handed to the active set). While the active set
-runs, the modes are part of its state (``tailbeam.solvers.stream.active.set``: the plate pairs
+runs, the modes are part of its state (``stream.active.integrator.set``: the plate pairs
 feel w = phi . q, the modes feel -phi F) and come back here after every advance.
 
 ``deflection_bound`` bounds |w| anywhere on the plate until the next contact: each mode's

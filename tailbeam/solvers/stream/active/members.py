@@ -1,6 +1,6 @@
 """The active set as the stream driver sees it: members by ball number, pairs by key.
 
-``tailbeam.solvers.stream.active.set.ActiveSet`` integrates a fixed list of balls and pairs.
+``integrator.set.ActiveSet`` integrates a fixed list of balls and pairs.
 Here members come and go (a ball lands, a neighbour comes within reach, a ball flies off), so
 the set is rebuilt on the next use after a change, carrying over each pair's state (touching,
 region flags, peak force, maximum penetration) by its key: (i, -1) for ball i on the plate,
@@ -9,9 +9,9 @@ balls near a contact). A set rebuilt at the instant of an event carries the rows
 were applied then (``carry.CarriedRows``), so that it does not apply the same event again at
 once (``kernel.advance``).
 
-Its parts: the plate force histories (``forces.PlateForces``), putting a member at rest
-(``rest``) and, on the modal plate, the plate pairs' shapes, compliance and tails
-(``plate_pairs.PlatePairs``).
+Its parts: the plate force histories (``plate.forces.PlateForces``), putting a member at rest
+(``plate.rest``) and, on the modal plate, the plate pairs' shapes, compliance and tails
+(``plate.pairs.PlatePairs``).
 """
 
 import math
@@ -25,10 +25,10 @@ from tailbeam.results.records import EventCode
 from tailbeam.solvers.stream.active import friction_pairs
 from tailbeam.solvers.stream.active.carry import CarriedRows
 from tailbeam.solvers.stream.active.compiled.pairs import first_contact_step
-from tailbeam.solvers.stream.active.forces import THIN, THIN_FRICTION, PlateForces
-from tailbeam.solvers.stream.active.plate_pairs import PlatePairs
-from tailbeam.solvers.stream.active.rest import excess_energy, place_at_rest, static_height
-from tailbeam.solvers.stream.active.set import ActiveSet
+from tailbeam.solvers.stream.active.integrator.set import ActiveSet
+from tailbeam.solvers.stream.active.plate.forces import THIN, THIN_FRICTION, PlateForces
+from tailbeam.solvers.stream.active.plate.pairs import PlatePairs
+from tailbeam.solvers.stream.active.plate.rest import excess_energy, place_at_rest, static_height
 
 
 class ActiveMembers:
@@ -424,7 +424,7 @@ class ActiveMembers:
         return s.contacts.accumulators(self.index[key])
 
     def make_quiet(self, i: int) -> float:
-        """Put ball i at rest on the plate (``rest``); returns the normal excess energy (J)
+        """Put ball i at rest on the plate (``plate.rest``); returns the normal excess energy (J)
         this removes."""
         s = self._ready()
         q, p = self.local[i], self.index[(i, -1)]
@@ -447,7 +447,7 @@ class ActiveMembers:
             s = self._ready()
             s.model.settle_energy[self.local[i]] = self.settle_energy(i)
 
-    # --- the modal plate's pairs (``plate_pairs``) ------------------------------------------
+    # --- the modal plate's pairs (``plate.pairs``) ------------------------------------------
     def refresh_shapes(self):
         """Modal plate: the mode shapes of every plate pair not touching, at its ball's
         position now (a touching pair keeps those of its contact point)."""

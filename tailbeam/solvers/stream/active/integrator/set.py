@@ -55,11 +55,11 @@ from tailbeam.solvers.numerics.chebyshev import tables as cheb_tables
 from tailbeam.solvers.numerics.dop853 import dop853_tables
 from tailbeam.solvers.stream.active.compiled import kernel as ak
 from tailbeam.solvers.stream.active.compiled.pairs import L_CRES, pair_state, plate_contact_energy
-from tailbeam.solvers.stream.active.contact_states import ContactStates
-from tailbeam.solvers.stream.active.kernel_io import KernelIO, Outcome
-from tailbeam.solvers.stream.active.modal_block import ModalBlock
-from tailbeam.solvers.stream.active.model import Model
-from tailbeam.solvers.stream.active.tolerances import Tolerances
+from tailbeam.solvers.stream.active.integrator.contact_states import ContactStates
+from tailbeam.solvers.stream.active.integrator.kernel_io import KernelIO, Outcome
+from tailbeam.solvers.stream.active.integrator.modal_block import ModalBlock
+from tailbeam.solvers.stream.active.integrator.model import Model
+from tailbeam.solvers.stream.active.integrator.tolerances import Tolerances
 
 DEFAULT_NODES = 40  # interior force rows per step: linear interpolation < 1e-5 of the peak
 

@@ -14,9 +14,9 @@ import numpy as np
 
 from tailbeam.physics.contact_patch import load_radius
 from tailbeam.solvers.stream.active.compiled.pairs import L_CRES
-from tailbeam.solvers.stream.active.rest import static_height
-from tailbeam.solvers.stream.active.shapes import ShapeCache
-from tailbeam.solvers.stream.active.tails import Tails
+from tailbeam.solvers.stream.active.plate.rest import static_height
+from tailbeam.solvers.stream.active.plate.shapes import ShapeCache
+from tailbeam.solvers.stream.active.plate.tails import Tails
 
 
 class PlatePairs:

@@ -27,7 +27,7 @@ written.
 
 import numpy as np
 
-from tailbeam.solvers.stream.active.thinning import keep_nodes
+from tailbeam.solvers.stream.active.plate.thinning import keep_nodes
 
 COUPLE_STEP = 1e-5  # m, half the distance between the two point loads of a couple
 THIN = 1e-8  # with friction: a dropped contact-force node's distance / the piece's peak
