@@ -15,7 +15,6 @@ input, as every command).
 from tailbeam.cachedir import announce_first_compile
 from tailbeam.io.output import atomic_output_dir, check_output_dir
 from tailbeam.progress import task
-from tailbeam.results.records import EventKind
 
 # The solver, figures and claims are imported in run(), so `tailbeam --help` stays fast.
 
@@ -37,6 +36,8 @@ def format_table(claims) -> str:
 
 def clamp_summary(results, results_off, claims_off) -> str:
     """One line: claims holding without the clamp, largest change of first-impact restitution."""
+    from tailbeam.results.records import EventKind
+
     changes = []
     for key, result in results.items():
         for ball in result.particles:

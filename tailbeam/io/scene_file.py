@@ -38,7 +38,7 @@ from tailbeam.scene import (
     SensorSpec,
 )
 from tailbeam.signals.noise import NoiseSpec
-from tailbeam.streams.generator import default_label
+from tailbeam.streams.generator import default_label, parse_stream
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -400,10 +400,6 @@ def _parse_streams(value, incline: InclinedPlate, materials: dict) -> tuple:
     tables = _array_of_tables("streams", value)
     if not tables:
         return ()
-    from tailbeam.streams.generator import (  # scipy.special: only for streams
-        parse_stream,
-    )
-
     streams = tuple(parse_stream(t, i, incline, materials) for i, t in enumerate(tables, 1))
     for s in streams:
         plausible.check_stream(s, incline.plate)

@@ -9,17 +9,17 @@ delta_dot (m/s, > 0 while approaching), Adams evaluates
 k in N/m^e, c in N s/m, d in m. The max(0, .) clamp is Adams' behaviour; the paper's eq. 1
 leaves it out (``clamp=False`` reproduces eq. 1 literally, with its adhesive pull at the end of
 rebound). The law's formula is written once, in ``tailbeam.physics.impact`` (numba); this
-module holds the parameters (``ImpactLaw``, Hertz stiffness) and array wrappers of that core.
+module holds the parameters (``ImpactLaw``, Hertz stiffness) and array wrappers of that core
+(``tailbeam.physics.impact_ufuncs``). numba loads when a force is first evaluated, not when a
+law is built (a scene read builds laws and evaluates none).
 """
 
 import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import vectorize
 
 from tailbeam.errors import InputError, require_nonnegative, require_positive
-from tailbeam.physics import impact
 from tailbeam.physics.materials import Material, effective_modulus
 
 HERTZ_EXPONENT = 1.5
@@ -110,78 +110,66 @@ def ball_ball_law(
 
 
 # --- Array wrappers of the law's one definition (tailbeam.physics.impact) ------------------
-# numba ufuncs (compiled on first use, cached) that call the scalar core, so the formula is
-# written once: they broadcast like numpy ('law' may hold arrays of parameters, one per pair;
-# ``ramp`` / ``clamped`` arrays of flags). The region forms serve integrators that stop at every
-# kink: ``ramp`` (delta < d: damping c STEP(delta, 0, 0, d, c), the cubic extended past d) or
-# full damping (c), and ``clamped`` (Adams' max(0, .) active: force 0).
-
-step_scalar = impact.step
-"""Adams STEP of floats (``tailbeam.physics.impact.step``)."""
-
-impact_force_scalar = impact.force
-"""IMPACT force in N of floats: (delta m, delta_dot m/s, stiffness, exponent, damping,
-penetration, clamp) (``tailbeam.physics.impact.force``)."""
+# They call the numba ufuncs of ``impact_ufuncs`` (imported on first use), so the formula is
+# written once.
 
 
-@vectorize(cache=True)
-def _step(x, x0, h0, x1, h1):
-    return impact.step(x, x0, h0, x1, h1)
+def __getattr__(name: str):
+    """The compiled names, imported on first use (PEP 562): ``step_scalar`` (Adams STEP of
+    floats, ``impact.step``), ``impact_force_scalar`` (the force in N of floats: delta m,
+    delta_dot m/s, stiffness, exponent, damping, penetration, clamp; ``impact.force``) and
+    ``impact_force_array`` (the same as a ufunc)."""
+    if name in ("step_scalar", "impact_force_scalar"):
+        from tailbeam.physics import impact
+
+        return impact.step if name == "step_scalar" else impact.force
+    if name == "impact_force_array":
+        return _ufuncs().impact_force_array
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-@vectorize(cache=True)
-def impact_force_array(delta, rate, k, e, c, d, clamp):
-    """``impact_force_scalar`` as a ufunc: every argument may be an array (one per pair)."""
-    return impact.force(delta, rate, k, e, c, d, clamp)
+def _ufuncs():
+    from tailbeam.physics import impact_ufuncs
 
-
-@vectorize(cache=True)
-def _region_damping(delta, c, d, ramp):
-    return impact.region_damping(delta, c, d, ramp)
-
-
-@vectorize(cache=True)
-def _region_force(delta, rate, k, e, c, d, ramp, clamped):
-    return impact.region_force(delta, rate, k, e, c, d, ramp, clamped)
-
-
-@vectorize(cache=True)
-def _elastic_energy(delta, k, e):
-    return impact.elastic_energy(delta, k, e)
+    return impact_ufuncs
 
 
 def step(x, x0: float, h0: float, x1: float, h1: float):
     """Array version of ``step_scalar``."""
-    return _step(np.asarray(x, dtype=float), x0, h0, x1, h1)
+    return _ufuncs().step(np.asarray(x, dtype=float), x0, h0, x1, h1)
 
 
 def impact_force(delta, delta_dot, law: ImpactLaw):
     """IMPACT force in N (arrays) of penetrations ``delta`` (m) and rates ``delta_dot`` (m/s)
     under ``law``."""
-    return impact_force_array(_floats(delta), _floats(delta_dot), *_parameters(law), law.clamp)
+    force = _ufuncs().impact_force_array
+    return force(_floats(delta), _floats(delta_dot), *_parameters(law), law.clamp)
 
 
 def damping_in_region(delta, law: ImpactLaw, ramp):
     """Damping coefficient in N s/m: the STEP cubic (extended past [0, d]) where ``ramp``,
     else c."""
-    return _region_damping(_floats(delta), law.damping, law.penetration, ramp)
+    return _ufuncs().region_damping(_floats(delta), law.damping, law.penetration, ramp)
 
 
 def impact_force_in_region(delta, delta_dot, law: ImpactLaw, ramp, clamped):
     """Force in N of one region's smooth formula; delta <= 0 gives the elastic term 0; 0 where
     ``clamped``."""
-    return _region_force(_floats(delta), _floats(delta_dot), *_parameters(law), ramp, clamped)
+    force = _ufuncs().region_force
+    return force(_floats(delta), _floats(delta_dot), *_parameters(law), ramp, clamped)
 
 
 def clamp_indicator(delta: float, delta_dot: float, law: ImpactLaw, ramp: bool) -> float:
     """Unclamped force / (k delta^e): the sign of the unclamped force, not 0 at delta = 0
     (``tailbeam.physics.impact.clamp_indicator``)."""
+    from tailbeam.physics import impact
+
     return impact.clamp_indicator(float(delta), float(delta_dot), *_parameters(law), bool(ramp))
 
 
 def elastic_energy(delta, law: ImpactLaw):
     """Energy in J stored by the elastic term: k delta^(e+1) / (e+1) for delta > 0, else 0."""
-    return _elastic_energy(_floats(delta), law.stiffness, law.exponent)
+    return _ufuncs().elastic_energy(_floats(delta), law.stiffness, law.exponent)
 
 
 def law_table(laws) -> np.ndarray:

@@ -17,8 +17,6 @@ rigid-plate solver is tested against.
 
 import math
 
-from scipy.special import beta
-
 from tailbeam.errors import require_positive
 
 
@@ -42,6 +40,8 @@ def hertz_peak_force(mass: float, speed: float, stiffness: float, exponent: floa
 
 def hertz_duration_factor(exponent: float = 1.5) -> float:
     """The dimensionless 2 I(e) of t_c = 2 I(e) delta_m / v; 2.9432 for e = 3/2."""
+    from scipy.special import beta  # here: importing scipy.special costs more than a scene read
+
     require_positive("exponent", exponent)
     p = exponent + 1.0
     return 2.0 * beta(1.0 / p, 0.5) / p

@@ -26,7 +26,6 @@ for n bodies, plus the pairs found near each other in space and time.
 import math
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from tailbeam.errors import InputError
 
@@ -44,6 +43,8 @@ def check_ball_pairs(balls) -> None:
     whose bodies overlap at release."""
     if len(balls) < 2:
         return
+    from scipy.spatial import cKDTree  # here: most scenes have one ball or none
+
     centres = np.array([b.position for b in balls])
     radii = np.array([b.radius for b in balls])
     pairs = cKDTree(centres).query_pairs(2.0 * radii.max(), output_type="ndarray")
@@ -112,9 +113,10 @@ def _first_reach(p0: float, v: float, a: float, half: float) -> float:
 def check_particles_against_balls(scene) -> None:
     """InputError naming ``streams[q].area`` for the first stream particle (in release
     order) that overlaps a ball at its release (module docstring)."""
-    first = len(scene.balls)
-    particles = scene.particles[first:]
-    if not particles or not scene.balls:
+    if not scene.balls:
+        return
+    particles = scene.particles[len(scene.balls) :]
+    if not particles:
         return
     t = np.array([p.t_release for p in particles])
     x = np.array([p.position for p in particles])
@@ -143,6 +145,8 @@ def _candidates(balls, paths, x, t, r_max):
     the path and c dt <= r + r_max; every particle that overlaps the ball at its release
     time is within sqrt((r + r_max + step)^2 + (c dt / 2)^2) of the sample nearest that
     time (step: the path's length between samples). The exact test is the caller's."""
+    from scipy.spatial import cKDTree
+
     tree = cKDTree(np.column_stack([x, TIME_SCALE * t]))
     points, owners, reach = [], [], []
     for i, (b, (t_end, acc)) in enumerate(zip(balls, paths, strict=True)):

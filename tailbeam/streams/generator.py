@@ -46,7 +46,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import ndtr, ndtri
 
 from tailbeam.errors import (
     InputError,
@@ -331,6 +330,8 @@ def _size_distribution(settings, field, radius):
 def _cdf(dist, params, r):
     """P(R <= r) of the untruncated distribution."""
     if dist == "lognormal":
+        from scipy.special import ndtr  # here: only a lognormal stream pays its import
+
         median, sigma = params
         return ndtr(np.log(r / median) / sigma)
     r63, n = params
@@ -339,6 +340,8 @@ def _cdf(dist, params, r):
 
 def _inverse_cdf(dist, params, p):
     if dist == "lognormal":
+        from scipy.special import ndtri
+
         median, sigma = params
         return median * np.exp(sigma * ndtri(p))
     r63, n = params
@@ -378,6 +381,8 @@ class _Draws:
 
 
 def _draw(s: StreamSettings) -> _Draws:
+    from scipy.special import ndtri
+
     # the sixth child leaves the first five, and so every other quantity, as they were
     gens = [
         np.random.Generator(np.random.PCG64(c)) for c in np.random.SeedSequence(s.seed).spawn(6)
