@@ -2,7 +2,8 @@
 friction law (a prototype in numpy/scipy, outside the compiled kernel).
 
 One coal ball (r = 30 mm) strikes the rigid carbon-steel plate obliquely, v_n = 2 m/s,
-v_t = 0.3 m/s, no spin, no gravity, IMPACT normal law (c = 300 N s/m, d = 1e-4 m, clamp),
+v_t = 0.3 m/s, no spin, no gravity (``--incline DEG``: the plate inclined, x downhill),
+IMPACT normal law (c = 300 N s/m, d = 1e-4 m, clamp),
 mu_s = mu_d = 0.5 (``--static``), v_d = 2 v_s, rolling resistance mu_r (``--rolling``,
 default 0; the caving-stream bench's 0.1 stops the ball's spin and slip within the impact).
 The contact point's slip stops during the impact and the regularised law holds it (and with
@@ -50,7 +51,8 @@ of ``--stiction`` (its convergence order).
 Writes DIR/table.md and DIR/study.csv (``--coulomb``: DIR/coulomb.md).
 
     python benchmarks/study_sticking_step.py --out DIR [--quick] [--static MU] [--rolling MU_R]
-        [--kinks] [--coulomb] [--stiction V ...] [--rtols RTOL ...] [--methods NAME ...]
+        [--kinks] [--coulomb] [--incline DEG] [--stiction V ...] [--rtols RTOL ...]
+        [--methods NAME ...]
 """
 
 import argparse
@@ -66,7 +68,7 @@ from scipy.linalg import lu_factor, lu_solve
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tailbeam.physics.bodies import Ball  # noqa: E402
+from tailbeam.physics.bodies import STANDARD_GRAVITY, Ball  # noqa: E402
 from tailbeam.physics.contact_law import ball_plate_law  # noqa: E402
 from tailbeam.physics.friction import coefficient, rolling_torque  # noqa: E402
 from tailbeam.physics.impact import clamp_indicator, region_force  # noqa: E402
@@ -80,7 +82,10 @@ X, Z, VX, VZ, WY = range(5)
 
 class Impact:
     """The oblique impact's right-hand side, region by region (``ramp``, ``clamped``: the
-    IMPACT law's regions, ``tailbeam.physics.impact``), with v_s the stiction velocity (m/s)."""
+    IMPACT law's regions, ``tailbeam.physics.impact``), with v_s the stiction velocity (m/s).
+    ``gravity``: (g_x, g_z) in the plate frame (m/s^2), set by ``--incline``."""
+
+    gravity = (0.0, 0.0)
 
     def __init__(self, v_s, static=0.5, rolling=0.0):
         self.law = ball_plate_law(COAL, R, CARBON_STEEL, damping=300.0)
@@ -106,7 +111,9 @@ class Impact:
         mu = float(coefficient(abs(slip), *self.mu))
         ft = -mu * abs(fn) * math.copysign(1.0, slip) if slip != 0.0 else 0.0
         tau = float(rolling_torque(np.array([0.0, y[WY], 0.0]), fn, self.rolling, R, self.mu[2])[1])
-        return np.array([y[VX], y[VZ], ft / self.m, fn / self.m, (tau - y[Z] * ft) / self.inertia])
+        gx, gz = self.gravity
+        return np.array([y[VX], y[VZ], ft / self.m + gx, fn / self.m + gz,
+                         (tau - y[Z] * ft) / self.inertia])  # fmt: skip
 
     def friction_jacobian(self, y):
         """d f / d y with only the friction force's derivative in the slip at fixed F_n
@@ -233,15 +240,18 @@ class Coulomb(Impact):
             return fn, ft, z * ft
         if self.roll:  # slip stuck: d(v_x - z w_y)/dt = 0
             tau = -limit_r * self.roll
-            ft = (y[VZ] * y[WY] + z * tau / inertia) / (1.0 / m + z * z / inertia)
+            ft = (y[VZ] * y[WY] + z * tau / inertia - self.gravity[0]) / (1.0 / m + z * z / inertia)
             return fn, ft, tau
-        return fn, 0.0, 0.0  # both stuck: v_x = w_y = 0 held
+        ft = -m * self.gravity[0]  # both stuck: v_x = w_y = 0 held
+        return fn, ft, z * ft
 
     def __call__(self, t, y):
         self.nfev += 1
         fn, ft, tau = self.forces(y)
         fz = self.normal(y)
-        return np.array([y[VX], y[VZ], ft / self.m, fz / self.m, (tau - y[Z] * ft) / self.inertia])
+        gx, gz = self.gravity
+        return np.array([y[VX], y[VZ], ft / self.m + gx, fz / self.m + gz,
+                         (tau - y[Z] * ft) / self.inertia])  # fmt: skip
 
     def switches(self):
         """Events of the current modes: the slip / spin reaching 0, a stuck force or torque
@@ -472,6 +482,8 @@ def main(argv=None):
     parser.add_argument("--rtols", type=float, nargs="+", default=[1e-8, 1e-10, 1e-11])
     parser.add_argument("--kinks", action="store_true",
                         help="split the intervals at the friction law's kinks too")  # fmt: skip
+    parser.add_argument("--incline", type=float, default=None,
+                        help="gravity, the plate inclined by DEG degrees")  # fmt: skip
     parser.add_argument("--coulomb", action="store_true",
                         help="the Coulomb limit with stick/slip events: its cost, and the "
                         "regularised law's convergence to it (the --stiction ladder)")  # fmt: skip
@@ -480,6 +492,9 @@ def main(argv=None):
     args.out.mkdir(parents=True, exist_ok=True)
     ladder = [1e-3] if args.quick else args.stiction
     rtols = [1e-10] if args.quick else args.rtols
+    if args.incline is not None:
+        theta = math.radians(args.incline)
+        Impact.gravity = (STANDARD_GRAVITY * math.sin(theta), -STANDARD_GRAVITY * math.cos(theta))
     if args.coulomb:
         return coulomb_study(args, ladder, rtols)
     rows = []
