@@ -153,10 +153,11 @@ class Membership:
         xc = self.act.positions(core)
         # energy a core ball can receive: the core's kinetic and elastic energy, plus what
         # gravity can give in h (a drop of REACH_DROP of every core ball: far more than they
-        # fall); with sleeping lumps pooled per touching cluster (``Sleepers.speed_bounds``)
+        # fall); with sleeping lumps, per touching cluster and gravity's work bounded by the
+        # drops the bound itself allows (``Sleepers.speed_bounds``)
         g = np.linalg.norm(b.g)
         if self.sleepers is not None:
-            sc = self.sleepers.speed_bounds(core, REACH_DROP, h)
+            sc = self.sleepers.speed_bounds(core, h)
         else:
             energy = self.act.energy(core) + np.sum(b.mass[core]) * g * REACH_DROP
             sc = np.sqrt(2.0 * energy / b.mass[core]) + g * h

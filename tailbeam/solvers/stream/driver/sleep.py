@@ -28,7 +28,9 @@ active set (at least every ``membership.SET_HORIZON``):
 import numpy as np
 
 from tailbeam.results.records import End
+from tailbeam.solvers.stream.active.reach import group_speed_bounds
 from tailbeam.solvers.stream.driver.balls import SLEEP
+from tailbeam.solvers.stream.driver.membership import SET_HORIZON
 from tailbeam.solvers.stream.driver.statics import in_equilibrium
 
 SLEEP_DWELL = 0.02  # s: a cluster is frozen after its balls have been slow this long
@@ -80,9 +82,12 @@ class Sleepers:
             else:
                 self.slow_since.pop(i, None)
         ready = {i for i in slow if t - self.slow_since[i] >= SLEEP_DWELL} - set(excluded)
+        clusters = [(c, k) for c, k in self._clusters(ready, touching) if any(q[1] < 0 for q in k)]
+        reached = self._reached([c for c, _ in clusters], core)
         frozen = []
-        for comp, keys in self._clusters(ready, touching):
-            if not any(k[1] < 0 for k in keys):
+        for (comp, keys), near in zip(clusters, reached, strict=True):
+            if near:  # an awake ball could touch it before the next check: it would be woken
+                self.clock.count("sleep_deferred")
                 continue
             if not self._holds(comp, keys):
                 self.clock.count("sleep_refused")
@@ -92,6 +97,25 @@ class Sleepers:
             self._freeze(comp, keys)
             frozen.extend(comp)
         return frozen
+
+    def _reached(self, comps, core) -> list:
+        """For each cluster of ``comps`` (lists of balls, all frozen now): could a ball of
+        ``core`` left awake touch it within the set's horizon (``speed_bounds``)? Such a
+        cluster would be woken at once (``membership``): it stays awake, its balls ready."""
+        if not comps:
+            return []
+        awake = sorted(set(core) - {i for c in comps for i in c})
+        if not awake:
+            return [False] * len(comps)
+        b, h = self.balls, SET_HORIZON
+        xa = self.act.positions(awake)
+        reach = b.radius[awake] + self.speed_bounds(awake, h) * h
+        out = []
+        for comp in comps:
+            xs = self.act.positions(comp)
+            d2 = np.sum((xs[:, None, :] - xa[None, :, :]) ** 2, axis=2)
+            out.append(bool(np.any(d2 <= (b.radius[comp][:, None] + reach[None, :]) ** 2)))
+        return out
 
     def _is_slow(self, i: int, keys) -> bool:
         """Ball i touches something (``keys``), its centre moves slower than SLEEP_SPEED,
@@ -187,13 +211,13 @@ class Sleepers:
         self.clock.count("balls_put_to_sleep", len(comp))
 
     # --- reach ---------------------------------------------------------------------------------
-    def speed_bounds(self, core, drop: float, h: float) -> np.ndarray:
-        """Speed bounds (m/s, one per ball of ``core``) over the next ``h`` s: the kinetic
-        energy (rotation included) and contacts' elastic energy of the ball's touching
-        cluster, plus a drop of ``drop`` m of each of its balls, all given to the ball; and
-        g h. Until the active set's next event (where this is computed again) its touching
-        pairs stay as they are, so energy moves only within a touching cluster: a resting
-        lump far from the moving ones wakes none of its sleeping neighbours."""
+    def speed_bounds(self, core, h: float) -> np.ndarray:
+        """Speed bounds (m/s, one per ball of ``core``) over the next ``h`` s: those of the
+        ball's touching cluster as an isolated group (``reach.group_speed_bounds``: its
+        kinetic, rotation included, and elastic energy plus the work gravity can do on it
+        within h). Until the active set's next event (where this is computed again) its
+        touching pairs stay as they are, so energy moves only within a touching cluster: a
+        resting lump far from the moving ones wakes none of its sleeping neighbours."""
         act, b = self.act, self.balls
         g = float(np.linalg.norm(b.g))
         root = {}
@@ -206,18 +230,24 @@ class Sleepers:
         for i, j in act.touching_keys():
             if j >= 0 and find(i) != find(j):
                 root[find(i)] = find(j)
-        members = {int(i) for i in core} | set(root)
-        energy, mass = {}, {}
-        for i in members:
-            _, v = act.state(i)
-            w = act.spin(i)
-            e = 0.5 * b.mass[i] * float(v @ v) + 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
-            e += act.elastic_energy_of(i)  # (half of each ball-ball pair: both are here)
-            r = find(i)
-            energy[r] = energy.get(r, 0.0) + e
-            mass[r] = mass.get(r, 0.0) + b.mass[i]
-        pooled = np.array([energy[find(int(i))] + mass[find(int(i))] * g * drop for i in core])
-        return np.sqrt(2.0 * pooled / b.mass[np.asarray(core)]) + g * h
+        groups = {}
+        for i in {int(i) for i in core} | set(root):
+            groups.setdefault(find(i), []).append(i)
+        bound = {}
+        for grp in groups.values():
+            energy = sum(self._energy_of(i) for i in grp)
+            for i, s in zip(grp, group_speed_bounds(energy, b.mass[grp], g, h), strict=True):
+                bound[i] = s
+        return np.array([bound[int(i)] for i in core])
+
+    def _energy_of(self, i: int) -> float:
+        """Kinetic energy (rotation included) of member i and its share of its contacts'
+        elastic energy (J; half of each ball-ball pair's)."""
+        b, act = self.balls, self.act
+        _, v = act.state(i)
+        w = act.spin(i)
+        e = 0.5 * b.mass[i] * float(v @ v) + 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
+        return e + act.elastic_energy_of(i)
 
     # --- waking -------------------------------------------------------------------------------
     def wake(self, i: int, make_core) -> list:
