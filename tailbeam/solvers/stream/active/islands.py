@@ -159,19 +159,24 @@ class Islands:
         horizon)."""
         b = self.balls
         g = float(np.linalg.norm(b.g))
+        balls = [i for grp in groups for i in grp]
+        energy = dict(zip(balls, self.ball_energies(balls).tolist(), strict=True))
         out = {}
         for grp in groups:
-            energy = sum(self._energy_of(i) for i in grp)
-            for i, s in zip(grp, group_speed_bounds(energy, b.mass[grp], g, horizon), strict=True):
+            pooled = sum(energy[i] for i in grp)
+            for i, s in zip(grp, group_speed_bounds(pooled, b.mass[grp], g, horizon), strict=True):
                 out[i] = float(s)
         return out
 
-    def _energy_of(self, i: int) -> float:
-        b = self.balls
-        _, v = self.state(i)
-        w = self.spin(i)
-        e = 0.5 * b.mass[i] * float(v @ v) + 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
-        return e + self.of[i].elastic_energy_of(i)
+    def ball_energies(self, balls) -> np.ndarray:
+        """As ``ActiveMembers.ball_energies``, the members ``balls`` in any islands."""
+        out = np.zeros(len(balls))
+        by = {}
+        for k, i in enumerate(balls):
+            by.setdefault(self.of[int(i)], []).append(k)
+        for isl, ks in by.items():
+            out[ks] = isl.ball_energies([balls[k] for k in ks])
+        return out
 
     def group(self, horizon: float) -> tuple[list, set]:
         """The islands for the next ``horizon`` (s): touching balls together, then groups

@@ -157,7 +157,7 @@ class Membership:
         # drops the bound itself allows (``Sleepers.speed_bounds``)
         g = np.linalg.norm(b.g)
         if self.sleepers is not None:
-            sc = self.sleepers.speed_bounds(core, h)
+            sc = self.sleepers.reach_bounds(core)  # (those of the check just made)
         else:
             energy = self.act.energy(core) + np.sum(b.mass[core]) * g * REACH_DROP
             sc = np.sqrt(2.0 * energy / b.mass[core]) + g * h

@@ -63,12 +63,15 @@ class Sleepers:
         self.records, self.loads, self.ledger = records, loads, ledger
         self.slow_since = {}  # core ball -> time (s) since which it has been slow
         self.cluster = {}  # sleeping ball -> the tuple of its frozen cluster
+        self.reach = {}  # core ball -> its speed bound (m/s) at the last check
 
     # --- freezing -----------------------------------------------------------------------------
     def check(self, core, excluded) -> list:
         """Freeze the clusters of ``core`` (set of ball numbers) ready to sleep; balls in
         ``excluded`` are not frozen now. Returns the balls frozen."""
         t = self.clock.t
+        order = sorted(core)
+        self.reach = dict(zip(order, self.speed_bounds(order, SET_HORIZON).tolist(), strict=True))
         touching = {}
         for key in self.act.touching_keys():
             for k in key:
@@ -109,7 +112,7 @@ class Sleepers:
             return [False] * len(comps)
         b, h = self.balls, SET_HORIZON
         xa = self.act.positions(awake)
-        reach = b.radius[awake] + self.speed_bounds(awake, h) * h
+        reach = b.radius[awake] + self.reach_bounds(awake) * h
         out = []
         for comp in comps:
             xs = self.act.positions(comp)
@@ -233,21 +236,22 @@ class Sleepers:
         groups = {}
         for i in {int(i) for i in core} | set(root):
             groups.setdefault(find(i), []).append(i)
+        balls = [i for grp in groups.values() for i in grp]
+        energy = dict(zip(balls, act.ball_energies(balls).tolist(), strict=True))
         bound = {}
         for grp in groups.values():
-            energy = sum(self._energy_of(i) for i in grp)
-            for i, s in zip(grp, group_speed_bounds(energy, b.mass[grp], g, h), strict=True):
+            pooled = sum(energy[i] for i in grp)
+            for i, s in zip(grp, group_speed_bounds(pooled, b.mass[grp], g, h), strict=True):
                 bound[i] = s
         return np.array([bound[int(i)] for i in core])
 
-    def _energy_of(self, i: int) -> float:
-        """Kinetic energy (rotation included) of member i and its share of its contacts'
-        elastic energy (J; half of each ball-ball pair's)."""
-        b, act = self.balls, self.act
-        _, v = act.state(i)
-        w = act.spin(i)
-        e = 0.5 * b.mass[i] * float(v @ v) + 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
-        return e + act.elastic_energy_of(i)
+    def reach_bounds(self, core) -> np.ndarray:
+        """``speed_bounds`` over SET_HORIZON of the balls ``core``: those found by the last
+        ``check`` (nothing has moved since, and a frozen cluster pools with no awake ball),
+        else computed now."""
+        if all(int(i) in self.reach for i in core):
+            return np.array([self.reach[int(i)] for i in core])
+        return self.speed_bounds(core, SET_HORIZON)
 
     # --- waking -------------------------------------------------------------------------------
     def wake(self, i: int, make_core) -> list:
