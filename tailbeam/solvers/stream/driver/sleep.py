@@ -13,16 +13,18 @@ active set (at least every ``membership.SET_HORIZON``):
   the ball is frozen);
 * a CLUSTER is a connected set of core balls through touching ball-ball contacts, at least
   one of them touching the plate; it is frozen when every ball of it has been slow for
-  SLEEP_DWELL, and the rigid statics of its contacts admit equilibrium within the Coulomb
-  and rolling limits (``statics.in_equilibrium``; refused: slow again from now);
+  SLEEP_DWELL, no core ball left awake could reach it within the set's horizon (it would be
+  woken at once: it waits, ready, counted in ``sleep_deferred``), and the rigid statics of
+  its contacts admit equilibrium within the Coulomb and rolling limits
+  (``statics.in_equilibrium``; refused: slow again from now);
 * frozen, its balls leave the active set and are ASLEEP (``balls.SLEEP``): velocity and
   angular velocity exactly zero, position fixed, their contacts at the penetrations they
   had (their records end as ``rest``; the kinetic energy dropped is counted in
   ``rest_energy_removed``, the contacts' elastic energy stays with the balls);
 * a sleeping ball that something could reach (a closed-form ball's predicted touch, or a
-  core ball within the set's reach) wakes its whole cluster: the balls rejoin the active
-  set at rest with their contacts touching (resumed contact records) and are integrated
-  until they are frozen again or move off.
+  core ball within the set's reach: ``speed_bounds``) wakes its whole cluster: the balls
+  rejoin the active set at rest with their contacts touching (resumed contact records) and
+  are integrated until they are frozen again or move off.
 """
 
 import numpy as np
