@@ -202,3 +202,44 @@ def test_resting_lump_does_not_wake_its_frozen_neighbour():
     assert np.array_equal(r.final["a"][1], np.zeros(3))
     assert not [k for k in free.contacts if k.partner in "ab" and k.ball in "ab"]
     assert 0.0 <= ledger_gap(r)
+
+
+def beside(gap: float, v0: float = 0.014) -> list:
+    """Ball a at rest; ball b ``gap`` beside it (along x), rolling along y at ``v0``: rolling
+    resistance stops it in v0 / (5/7 mu_r g) (10 ms at mu_r = 0.2) after 70 µm, so b is slow
+    about 10 ms after a and the gap stays within 0.05 µm of ``gap``."""
+    b = ball("b", 2 * R + gap, velocity=(0.0, v0, 0.0), spin=(-v0 / R, 0.0, 0.0))
+    return [ball("a", 0.0), b]
+
+
+def test_lump_resting_close_beside_a_frozen_one_leaves_it_asleep():
+    """a is frozen (at ~20 ms) while b, 0.1 mm beside it, still comes to rest (frozen ~10 ms
+    later). Touching nothing else, b can gain only what gravity gives it within the set's
+    horizon (``reach``: at most 2 g h plus its own energy's speed, ~25 µm in 1 ms), so it
+    cannot reach a and a is not woken. The full integration is the truth that they never
+    touch; both end where it holds them, up to the creep before freezing."""
+    balls = beside(1e-4)
+    r = run(balls, 0.0, 0.1, rolling=0.2)
+    free = run(balls, 0.0, 0.1, rolling=0.2, sleep=False)
+    assert r.stats["sleeps"] == 2 and r.stats.get("wakes", 0) == 0
+    assert not [k for k in free.contacts if k.partner in "ab" and k.ball in "ab"]
+    for n in "ab":
+        assert np.linalg.norm(r.final[n][0] - free.final[n][0]) <= CREEP_BOUND
+    assert 0.0 <= ledger_gap(r)
+
+
+def test_resting_neighbours_are_frozen_without_waking_each_other():
+    """As above 5 µm apart, within the reach of either: a is ready first but would be woken at
+    once by b, so it waits awake until b is ready too, and both are frozen at that check: no
+    wake (freezing one and waking it at once, again and again, is what this avoids). The
+    full integration is the truth that they never touch; both end where it holds them, up to
+    the creep before freezing."""
+    balls = beside(5e-6)
+    r = run(balls, 0.0, 0.1, rolling=0.2)
+    free = run(balls, 0.0, 0.1, rolling=0.2, sleep=False)
+    assert r.stats["sleeps"] == 2 and r.stats.get("wakes", 0) == 0
+    assert r.stats["asleep_final"] == 2 and r.stats["sleep_deferred"] >= 1
+    assert not [k for k in free.contacts if k.partner in "ab" and k.ball in "ab"]
+    for n in "ab":
+        assert np.linalg.norm(r.final[n][0] - free.final[n][0]) <= CREEP_BOUND
+    assert 0.0 <= ledger_gap(r)

@@ -7,8 +7,8 @@ own ``ActiveMembers``, stepped on its own, and only the earliest event of all is
 
 Grouping is certified, not guessed. Until a contact between two islands starts, the
 energy an island's ball can receive is bounded by its island's kinetic (rotation included)
-and elastic energy plus a drop of ``REACH_DROP`` of each of its balls (what gravity gives in
-the horizon), so its speed is bounded (``speed_bounds``); islands whose balls, moving at
+and elastic energy plus the work gravity can do on the island within the horizon
+(``reach``), so its speed is bounded (``speed_bounds``); islands whose balls, moving at
 those speeds, stay more than their radii apart over the horizon cannot touch within it
 (merged until no two can: the bound of a merged island pools both). The grouping is made
 again at the first call past its horizon and after a change of the members; two islands
@@ -27,9 +27,9 @@ import numpy as np
 
 from tailbeam.results.records import EventCode
 from tailbeam.solvers.stream.active.members import ActiveMembers
+from tailbeam.solvers.stream.active.reach import group_speed_bounds
 
 HORIZON = 1e-3  # s: the islands are grouped for at least this long (the driver's horizon)
-REACH_DROP = 0.01  # m: a ball may gain the energy of a drop this high within the horizon
 
 
 class Islands:
@@ -154,25 +154,29 @@ class Islands:
     # --- grouping ---------------------------------------------------------------------------
     def speed_bounds(self, groups, horizon: float) -> dict:
         """Ball -> speed bound (m/s) over ``horizon`` (s) while its group touches no other:
-        the group's kinetic (rotation included) and elastic energy plus a drop of
-        REACH_DROP of each of its balls, all given to the ball; and g h."""
+        the group's as an isolated group (``reach.group_speed_bounds``: its kinetic, rotation
+        included, and elastic energy plus the work gravity can do on it within the
+        horizon)."""
         b = self.balls
         g = float(np.linalg.norm(b.g))
+        balls = [i for grp in groups for i in grp]
+        energy = dict(zip(balls, self.ball_energies(balls).tolist(), strict=True))
         out = {}
         for grp in groups:
-            energy = sum(self._energy_of(i) for i in grp)
-            mass = float(np.sum(b.mass[grp]))
-            pooled = energy + mass * g * REACH_DROP
-            for i in grp:
-                out[i] = float(np.sqrt(2.0 * pooled / b.mass[i])) + g * horizon
+            pooled = sum(energy[i] for i in grp)
+            for i, s in zip(grp, group_speed_bounds(pooled, b.mass[grp], g, horizon), strict=True):
+                out[i] = float(s)
         return out
 
-    def _energy_of(self, i: int) -> float:
-        b = self.balls
-        _, v = self.state(i)
-        w = self.spin(i)
-        e = 0.5 * b.mass[i] * float(v @ v) + 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
-        return e + self.of[i].elastic_energy_of(i)
+    def ball_energies(self, balls) -> np.ndarray:
+        """As ``ActiveMembers.ball_energies``, the members ``balls`` in any islands."""
+        out = np.zeros(len(balls))
+        by = {}
+        for k, i in enumerate(balls):
+            by.setdefault(self.of[int(i)], []).append(k)
+        for isl, ks in by.items():
+            out[ks] = isl.ball_energies([balls[k] for k in ks])
+        return out
 
     def group(self, horizon: float) -> tuple[list, set]:
         """The islands for the next ``horizon`` (s): touching balls together, then groups

@@ -372,6 +372,27 @@ class ActiveMembers:
         elastic = sum(s.contact_energy(p) for p in np.flatnonzero(s.contacts.touching))
         return kinetic + elastic
 
+    def ball_energies(self, balls) -> np.ndarray:
+        """Per ball of ``balls`` (members): its kinetic energy (rotation included with
+        friction), its plate contact's elastic energy and half of each of its touching
+        ball-ball pairs' (J): summed over a group holding both balls of each of its pairs,
+        the group's kinetic and elastic energy."""
+        s = self._ready()
+        q = np.array([self.local[int(i)] for i in balls], dtype=np.int64)
+        m = s.model.mass[q]
+        out = 0.5 * m * np.sum(s.v[q] * s.v[q], axis=1)
+        if self.friction is not None:
+            out += 0.2 * m * s.model.radius[q] ** 2 * np.sum(s.w[q] * s.w[q], axis=1)
+        where = {int(i): k for k, i in enumerate(balls)}
+        for p in np.flatnonzero(s.contacts.touching):
+            i, j = self.keys[p]
+            share = 1.0 if j < 0 else 0.5
+            e = share * s.contact_energy(p)
+            for k in (i, j):
+                if k in where:
+                    out[where[k]] += e
+        return out
+
     def elastic_energy_of(self, i: int, ball_share: float = 0.5) -> float:
         """Elastic energy (J) of member i's touching plate pair plus ``ball_share`` of each of
         its touching ball-ball pairs (half: the other half is its partner's; 1: the pairs

@@ -127,7 +127,7 @@ class Membership:
         if near is None:
             return
         for i in cand[near & ~b.in_set[cand]]:
-            self._absorb(int(i))
+            self._absorb_near(int(i))
         for i in cand[~near & b.in_set[cand]]:
             if b.status[i] != ACTIVE:  # (not a ball of a cluster woken just now)
                 self._exit(int(i))
@@ -153,10 +153,11 @@ class Membership:
         xc = self.act.positions(core)
         # energy a core ball can receive: the core's kinetic and elastic energy, plus what
         # gravity can give in h (a drop of REACH_DROP of every core ball: far more than they
-        # fall); with sleeping lumps pooled per touching cluster (``Sleepers.speed_bounds``)
+        # fall); with sleeping lumps, per touching cluster and gravity's work bounded by the
+        # drops the bound itself allows (``Sleepers.speed_bounds``)
         g = np.linalg.norm(b.g)
         if self.sleepers is not None:
-            sc = self.sleepers.speed_bounds(core, REACH_DROP, h)
+            sc = self.sleepers.reach_bounds(core)  # (those of the check just made)
         else:
             energy = self.act.energy(core) + np.sum(b.mass[core]) * g * REACH_DROP
             sc = np.sqrt(2.0 * energy / b.mass[core]) + g * h
@@ -229,6 +230,16 @@ class Membership:
         self._audit_overlap(i, x)
         self.act.add(i, x, v, quiet=b.status[i] == SLIDE)
         b.in_set[i] = True
+
+    def _absorb_near(self, i: int) -> None:
+        """Closed-form ball i, near a core ball, becomes a member; one released touching the
+        rigid plate (its own touch due at this instant) starts that contact now: the set
+        must know it, or it integrates the ball into the plate."""
+        b = self.balls
+        self._absorb(i)
+        if b.status[i] == FLY and self.plate is None and self.act.state(i)[0][2] < b.radius[i]:
+            self.act.start_contact((i, -1))
+            self.start((i, -1))
 
     def _exit(self, i: int) -> None:
         """Member i (not core) moves in closed form again."""

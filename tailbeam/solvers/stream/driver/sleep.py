@@ -13,22 +13,26 @@ active set (at least every ``membership.SET_HORIZON``):
   the ball is frozen);
 * a CLUSTER is a connected set of core balls through touching ball-ball contacts, at least
   one of them touching the plate; it is frozen when every ball of it has been slow for
-  SLEEP_DWELL, and the rigid statics of its contacts admit equilibrium within the Coulomb
-  and rolling limits (``statics.in_equilibrium``; refused: slow again from now);
+  SLEEP_DWELL, no core ball left awake could reach it within the set's horizon (it would be
+  woken at once: it waits, ready, counted in ``sleep_deferred``), and the rigid statics of
+  its contacts admit equilibrium within the Coulomb and rolling limits
+  (``statics.in_equilibrium``; refused: slow again from now);
 * frozen, its balls leave the active set and are ASLEEP (``balls.SLEEP``): velocity and
   angular velocity exactly zero, position fixed, their contacts at the penetrations they
   had (their records end as ``rest``; the kinetic energy dropped is counted in
   ``rest_energy_removed``, the contacts' elastic energy stays with the balls);
 * a sleeping ball that something could reach (a closed-form ball's predicted touch, or a
-  core ball within the set's reach) wakes its whole cluster: the balls rejoin the active
-  set at rest with their contacts touching (resumed contact records) and are integrated
-  until they are frozen again or move off.
+  core ball within the set's reach: ``speed_bounds``) wakes its whole cluster: the balls
+  rejoin the active set at rest with their contacts touching (resumed contact records) and
+  are integrated until they are frozen again or move off.
 """
 
 import numpy as np
 
 from tailbeam.results.records import End
+from tailbeam.solvers.stream.active.reach import group_speed_bounds
 from tailbeam.solvers.stream.driver.balls import SLEEP
+from tailbeam.solvers.stream.driver.membership import SET_HORIZON
 from tailbeam.solvers.stream.driver.statics import in_equilibrium
 
 SLEEP_DWELL = 0.02  # s: a cluster is frozen after its balls have been slow this long
@@ -61,12 +65,15 @@ class Sleepers:
         self.records, self.loads, self.ledger = records, loads, ledger
         self.slow_since = {}  # core ball -> time (s) since which it has been slow
         self.cluster = {}  # sleeping ball -> the tuple of its frozen cluster
+        self.reach = {}  # core ball -> its speed bound (m/s) at the last check
 
     # --- freezing -----------------------------------------------------------------------------
     def check(self, core, excluded) -> list:
         """Freeze the clusters of ``core`` (set of ball numbers) ready to sleep; balls in
         ``excluded`` are not frozen now. Returns the balls frozen."""
         t = self.clock.t
+        order = sorted(core)
+        self.reach = dict(zip(order, self.speed_bounds(order, SET_HORIZON).tolist(), strict=True))
         touching = {}
         for key in self.act.touching_keys():
             for k in key:
@@ -80,9 +87,12 @@ class Sleepers:
             else:
                 self.slow_since.pop(i, None)
         ready = {i for i in slow if t - self.slow_since[i] >= SLEEP_DWELL} - set(excluded)
+        clusters = [(c, k) for c, k in self._clusters(ready, touching) if any(q[1] < 0 for q in k)]
+        reached = self._reached([c for c, _ in clusters], core)
         frozen = []
-        for comp, keys in self._clusters(ready, touching):
-            if not any(k[1] < 0 for k in keys):
+        for (comp, keys), near in zip(clusters, reached, strict=True):
+            if near:  # an awake ball could touch it before the next check: it would be woken
+                self.clock.count("sleep_deferred")
                 continue
             if not self._holds(comp, keys):
                 self.clock.count("sleep_refused")
@@ -92,6 +102,25 @@ class Sleepers:
             self._freeze(comp, keys)
             frozen.extend(comp)
         return frozen
+
+    def _reached(self, comps, core) -> list:
+        """For each cluster of ``comps`` (lists of balls, all frozen now): could a ball of
+        ``core`` left awake touch it within the set's horizon (``speed_bounds``)? Such a
+        cluster would be woken at once (``membership``): it stays awake, its balls ready."""
+        if not comps:
+            return []
+        awake = sorted(set(core) - {i for c in comps for i in c})
+        if not awake:
+            return [False] * len(comps)
+        b, h = self.balls, SET_HORIZON
+        xa = self.act.positions(awake)
+        reach = b.radius[awake] + self.reach_bounds(awake) * h
+        out = []
+        for comp in comps:
+            xs = self.act.positions(comp)
+            d2 = np.sum((xs[:, None, :] - xa[None, :, :]) ** 2, axis=2)
+            out.append(bool(np.any(d2 <= (b.radius[comp][:, None] + reach[None, :]) ** 2)))
+        return out
 
     def _is_slow(self, i: int, keys) -> bool:
         """Ball i touches something (``keys``), its centre moves slower than SLEEP_SPEED,
@@ -187,13 +216,13 @@ class Sleepers:
         self.clock.count("balls_put_to_sleep", len(comp))
 
     # --- reach ---------------------------------------------------------------------------------
-    def speed_bounds(self, core, drop: float, h: float) -> np.ndarray:
-        """Speed bounds (m/s, one per ball of ``core``) over the next ``h`` s: the kinetic
-        energy (rotation included) and contacts' elastic energy of the ball's touching
-        cluster, plus a drop of ``drop`` m of each of its balls, all given to the ball; and
-        g h. Until the active set's next event (where this is computed again) its touching
-        pairs stay as they are, so energy moves only within a touching cluster: a resting
-        lump far from the moving ones wakes none of its sleeping neighbours."""
+    def speed_bounds(self, core, h: float) -> np.ndarray:
+        """Speed bounds (m/s, one per ball of ``core``) over the next ``h`` s: those of the
+        ball's touching cluster as an isolated group (``reach.group_speed_bounds``: its
+        kinetic, rotation included, and elastic energy plus the work gravity can do on it
+        within h). Until the active set's next event (where this is computed again) its
+        touching pairs stay as they are, so energy moves only within a touching cluster: a
+        resting lump far from the moving ones wakes none of its sleeping neighbours."""
         act, b = self.act, self.balls
         g = float(np.linalg.norm(b.g))
         root = {}
@@ -206,18 +235,25 @@ class Sleepers:
         for i, j in act.touching_keys():
             if j >= 0 and find(i) != find(j):
                 root[find(i)] = find(j)
-        members = {int(i) for i in core} | set(root)
-        energy, mass = {}, {}
-        for i in members:
-            _, v = act.state(i)
-            w = act.spin(i)
-            e = 0.5 * b.mass[i] * float(v @ v) + 0.2 * b.mass[i] * b.radius[i] ** 2 * float(w @ w)
-            e += act.elastic_energy_of(i)  # (half of each ball-ball pair: both are here)
-            r = find(i)
-            energy[r] = energy.get(r, 0.0) + e
-            mass[r] = mass.get(r, 0.0) + b.mass[i]
-        pooled = np.array([energy[find(int(i))] + mass[find(int(i))] * g * drop for i in core])
-        return np.sqrt(2.0 * pooled / b.mass[np.asarray(core)]) + g * h
+        groups = {}
+        for i in {int(i) for i in core} | set(root):
+            groups.setdefault(find(i), []).append(i)
+        balls = [i for grp in groups.values() for i in grp]
+        energy = dict(zip(balls, act.ball_energies(balls).tolist(), strict=True))
+        bound = {}
+        for grp in groups.values():
+            pooled = sum(energy[i] for i in grp)
+            for i, s in zip(grp, group_speed_bounds(pooled, b.mass[grp], g, h), strict=True):
+                bound[i] = s
+        return np.array([bound[int(i)] for i in core])
+
+    def reach_bounds(self, core) -> np.ndarray:
+        """``speed_bounds`` over SET_HORIZON of the balls ``core``: those found by the last
+        ``check`` (nothing has moved since, and a frozen cluster pools with no awake ball),
+        else computed now."""
+        if all(int(i) in self.reach for i in core):
+            return np.array([self.reach[int(i)] for i in core])
+        return self.speed_bounds(core, SET_HORIZON)
 
     # --- waking -------------------------------------------------------------------------------
     def wake(self, i: int, make_core) -> list:
