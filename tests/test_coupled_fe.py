@@ -11,8 +11,11 @@ no FE damping matrix; Rayleigh damping, which has one, is checked separately). S
 23x23, Mindlin 25x25) are compared in benchmarks/study_coupled_fe.py (minutes per reference).
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
+from session_results import shared
 
 from tailbeam.errors import InputError, WorkLimitError
 from tailbeam.physics.bodies import Ball, Plate
@@ -43,13 +46,16 @@ def _basis(theory, **band):
 
 @pytest.fixture(scope="module")
 def runs():
-    """(case, reference) per theory, built once (~7 s Kirchhoff, ~12 s Mindlin)."""
+    """(case, reference) per theory, the reference computed once per test session (~12 s CPU
+    Kirchhoff, ~7 s Mindlin; tests/test_coupled_ritz_tail.py reads the same ones)."""
     out = {}
 
     def get(theory):
         if theory not in out:
             case = _case(theory)
-            out[theory] = (case, case.reference(REF_DT[theory]))
+            inputs = (replace(case, model=("SSSS", theory, MESHES[theory])), REF_DT[theory])
+            ref = shared(f"fe-reference-{theory}", inputs, lambda: case.reference(inputs[1]))
+            out[theory] = (case, ref)
         return out[theory]
 
     return get

@@ -177,8 +177,9 @@ def _test_scores(test, target, inputs, fitted, x, y, classify) -> dict:
 
 
 def _importances(forest, names) -> dict:
-    order = np.argsort(forest.feature_importances_)[::-1]
-    return {names[i]: float(forest.feature_importances_[i]) for i in order}
+    importances = forest.feature_importances_  # (a property: every read sums all the trees)
+    order = np.argsort(importances)[::-1]
+    return {names[i]: float(importances[i]) for i in order}
 
 
 def _class_scores(y, pred, classes) -> dict:
