@@ -99,9 +99,14 @@ def test_solves_against_arpacks(plate, monkeypatch):
     calls = []
     monkeypatch.setattr(solid_modes, "lowest_modes", _counting(solid_modes.lowest_modes, calls))
     freqs, _ = solid_modes.solve_band(plate, fmax)
+    nev = len(freqs) + plate.rigid_modes + solid_modes.MARGIN
     predicted = C.solve_cost(plate.n_dofs, plate.stiffness.nnz, len(freqs),
                              plate.rigid_modes + solid_modes.MARGIN).solves  # fmt: skip
-    assert 0.8 * calls[0] <= predicted <= 1.25 * calls[0]
+    # ARPACK's count moves by whole restarts with round-off (BLAS threads, what ran before in
+    # the process: 57 and 73 solves for this plate); a restart applies the operator up to
+    # ncv - nev times
+    restart = min(plate.n_dofs, int(1.5 * nev) + 20) - nev
+    assert abs(predicted - calls[0]) <= restart
 
 
 def _counting(lowest_modes, calls):
