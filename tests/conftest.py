@@ -15,6 +15,7 @@ sktime's MiniRocket; the files that need those kernels come after, the longest f
 two workers finish together."""
 
 import os
+import sys
 import tempfile
 
 import pytest
@@ -24,6 +25,16 @@ _CACHE = os.environ.get("TAILBEAM_TEST_CACHE_DIR") or tempfile.mkdtemp(
 )
 os.environ["TAILBEAM_TEST_CACHE_DIR"] = _CACHE
 os.environ["TAILBEAM_CACHE_DIR"] = _CACHE
+
+# One BLAS thread per process, and in the processes the tests start (they inherit it): with
+# OpenBLAS's default of a thread per core, two xdist workers oversubscribe the cores and the
+# waiting threads burn CPU (as in the eigen-solves, which run on one: docs/plate-modes.md).
+for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
+if "numpy" in sys.modules:  # (loaded before this file: the variables came too late)
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(int(os.environ["OPENBLAS_NUM_THREADS"]), user_api="blas")
 
 # CPU seconds on a fresh cache, measured: ~50 each for the first two, then 80 down to ~8
 FIRST = [
