@@ -22,7 +22,7 @@ training set, then fitted on all of it and scored on the other sets, beside the 
 of the training set. Separability of simulated signals under this model, not field accuracies.
 
 Quick mode (the tests run it): 6 cases per class to train (4 for ``plates``), 4 per class to
-test, 3 folds, the forest only.
+test, 3 folds, the forest only, of 20 trees (200 in the full study).
 """
 
 import argparse
@@ -45,8 +45,9 @@ from tailbeam.study.windows import feature_table, window_table  # noqa: E402
 
 SENSORS = (("S1", (0.1, 0.15)), ("S2", (-0.15, 0.05)), ("S3", (0.05, -0.2)))
 SENSOR_SETS = {"S1": ["S1"], "S1+S2+S3": ["S1", "S2", "S3"]}
-FULL = {"train": 200, "test": 100, "plates": 150, "folds": 5, "models": ("forest", "minirocket")}
-QUICK = {"train": 6, "test": 4, "plates": 4, "folds": 3, "models": ("forest",)}
+FULL = {"train": 200, "test": 100, "plates": 150, "folds": 5, "models": ("forest", "minirocket"),
+        "trees": 200}  # fmt: skip
+QUICK = {"train": 6, "test": 4, "plates": 4, "folds": 3, "models": ("forest",), "trees": 20}
 PLATE_THICKNESSES = [0.008, 0.011, 0.014]  # m
 PLATE_BOUNDARIES = ["SSSS", "CSCS"]
 WINDOWS = {"window": "impact", "length": WINDOW_S, "pre": 0.0005, "first_only": True}
@@ -136,8 +137,9 @@ def main(
             run_sweep(parse_sweep(table), folders[name], workers=workers, client=client)
     rows = []
     for model in mode["models"]:
-        rows += transfer_rows(folders, model, mode["folds"])
-        rows += snr_rows(folders["train"], model, mode["folds"])
+        trees = mode["trees"] if model == "forest" else None
+        rows += transfer_rows(folders, model, mode["folds"], trees=trees)
+        rows += snr_rows(folders["train"], model, mode["folds"], trees=trees)
     write_rows(out / "transfer.csv", rows)
     return rows
 
@@ -159,9 +161,9 @@ def _row(model, sensors, training, normalise, tested, s, cv=False) -> dict:
     }
 
 
-def transfer_rows(folders: dict, model: str, folds: int, trainings=tuple(TESTS)) -> list:
+def transfer_rows(folders: dict, model: str, folds: int, trainings=tuple(TESTS), trees=None):
     """Each training set of ``trainings`` x sensor set x normalise: its grouped CV score and
-    its scores on the other sets."""
+    its scores on the other sets (a list of rows); ``trees``: the forest's."""
     keys = {**TRAINING, "h12": "test_h12", "cccc": "test_cccc"}
     data = {name: samples(folders[key], name, model) for name, key in keys.items()}
     rows = []
@@ -169,7 +171,7 @@ def transfer_rows(folders: dict, model: str, folds: int, trainings=tuple(TESTS))
         train = data[training]
         for label, sensors in SENSOR_SETS.items():
             for normalise in (False, True):
-                s = learn(train, folds=folds, sensors=sensors, model=model,
+                s = learn(train, folds=folds, sensors=sensors, model=model, trees=trees,
                           normalise=normalise, test=[data[t] for t in TESTS[training]])  # fmt: skip
                 rows.append(_row(model, label, training, normalise, training, s, cv=True))
                 rows += [
@@ -178,16 +180,16 @@ def transfer_rows(folders: dict, model: str, folds: int, trainings=tuple(TESTS))
     return rows
 
 
-def snr_rows(folder, model: str, folds: int) -> list:
+def snr_rows(folder, model: str, folds: int, trees=None) -> list:
     """Study 1 by model and sensors at SNR_DB (noise re the median clean window RMS over the
-    three sensors, one RMS for all)."""
+    three sensors, one RMS for all); ``trees``: the forest's."""
     clean = feature_table(folder, **WINDOWS)
     ref = float(np.median(clean[[f"{n}.rms" for n, _ in SENSORS]].to_numpy()))
     noise = ref / 10 ** (SNR_DB / 20)
     data = samples(folder, "nominal", model, noise)
     rows = []
     for label, sensors in SENSOR_SETS.items():
-        s = learn(data, folds=folds, sensors=sensors, model=model)
+        s = learn(data, folds=folds, sensors=sensors, model=model, trees=trees)
         rows.append({**_row(model, label, "nominal", False, "nominal", s, cv=True),
                      "snr_db": SNR_DB})  # fmt: skip
     return rows

@@ -72,15 +72,17 @@ def _run(*argv):
 
 def test_test_on_itself_is_the_fit_on_all_rows(sets, tmp_path):
     """--test TRAIN scores the model fitted on every row on those rows: a direct
-    scikit-learn fit-predict on the same columns (built here), and not below the CV score."""
+    scikit-learn fit-predict on the same columns (built here, of the --trees asked), and not
+    below the CV score."""
     from sklearn.ensemble import RandomForestClassifier
     from sklearn.impute import SimpleImputer
     from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
 
     train = sets["train"]
-    _run(train, "--test", train, "--out", tmp_path)
+    _run(train, "--test", train, "--out", tmp_path, "--trees", 7)
     scores = json.loads((tmp_path / "learn.json").read_text())
+    assert scores["trees"] == 7
     table = feature_table(train)
     cols = [c for c in table.columns if c.startswith(("S1.", "S2."))]
     assert scores["features"] == cols
@@ -89,7 +91,7 @@ def test_test_on_itself_is_the_fit_on_all_rows(sets, tmp_path):
     direct = make_pipeline(
         SimpleImputer(strategy="median"),
         StandardScaler(),
-        RandomForestClassifier(n_estimators=200, random_state=0, n_jobs=1),
+        RandomForestClassifier(n_estimators=7, random_state=0, n_jobs=1),
     ).fit(x, table["label"])
     expected = np.mean(direct.predict(x) == table["label"].to_numpy())
     assert scores["test"]["accuracy"] == pytest.approx(expected, abs=1e-12)
@@ -107,6 +109,7 @@ def test_a_gain_error_of_two_drops_the_score_and_normalise_recovers_it(sets, tmp
     _run(train, "--test", train, "--normalise", "--out", tmp_path / "self_norm")
     s = {k: json.loads((tmp_path / k / "learn.json").read_text()) for k in
          ("self", "gain", "gain_norm", "self_norm")}  # fmt: skip
+    assert s["self"]["trees"] == 200  # the default forest
     assert s["gain"]["test"]["accuracy"] < s["self"]["test"]["accuracy"] - 0.2
     # scale-free features of a doubled signal are the same numbers: same predictions
     assert s["gain_norm"]["test"]["confusion"] == s["self_norm"]["test"]["confusion"]
@@ -134,6 +137,23 @@ def test_refuses_another_dataset_without_the_sensors(sets, tmp_path, capsys):
         learn(table, folds=3, test=Samples(table.drop(columns="label"), name="OTHER"))
     with pytest.raises(InputError, match="--test.*'S2.kurtosis'"):
         learn(table, folds=3, test=Samples(table.drop(columns="S2.kurtosis"), name="OTHER"))
+
+
+@pytest.mark.parametrize(
+    "argv, rule",
+    [
+        (["--trees", "0"], "must be >= 1"),
+        (["--trees", "5", "--model", "minirocket"], "forest only"),
+    ],
+)
+def test_refuses_trees_it_cannot_grow(sets, tmp_path, capsys, argv, rule):
+    out = tmp_path / "never"
+    code = main(["learn", str(sets["train"]), "--out", str(out), *argv])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--trees" in err[0] and rule in err[0], err
+    assert not out.exists()
+    with pytest.raises(InputError, match="--trees"):
+        learn(feature_table(sets["train"]), folds=3, trees=2.5)
 
 
 def test_minirocket_reads_the_windows_the_features_are_computed_of(sets):

@@ -28,8 +28,6 @@ from types import SimpleNamespace
 import meshio
 import numpy as np
 import pytest
-from vtk import vtkXMLUnstructuredGridReader
-from vtk.util.numpy_support import vtk_to_numpy
 
 from tailbeam import simulate
 from tailbeam.cli.main import main
@@ -91,7 +89,11 @@ def read_pvd(path):
 
 
 def read_vtu(path):
-    """(points (p, 3), point fields {name: array}) of a VTU file, read by VTK."""
+    """(points (p, 3), point fields {name: array}) of a VTU file, read by VTK (imported here:
+    VTK takes ~2 s to import, which every pytest-xdist worker would pay at collection)."""
+    from vtk import vtkXMLUnstructuredGridReader
+    from vtk.util.numpy_support import vtk_to_numpy
+
     reader = vtkXMLUnstructuredGridReader()
     reader.SetFileName(str(path))
     reader.Update()

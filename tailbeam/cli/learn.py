@@ -44,6 +44,13 @@ def add_arguments(parser):
         help="a random forest on the features, or MiniRocket and ridge on the raw windows",
     )
     parser.add_argument(
+        "--trees",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the random forest's number of trees (default: 200; --model forest only)",
+    )
+    parser.add_argument(
         "--test",
         default=None,
         metavar="OTHER",
@@ -66,6 +73,10 @@ def run(args) -> int:
         raise InputError("--folds", f"must be >= 2, got {args.folds}")
     if args.model not in MODELS:
         raise InputError("--model", f"must be one of {MODELS}, got {args.model!r}")
+    if args.trees is not None and args.model != "forest":
+        raise InputError("--trees", f"applies to --model forest only, not {args.model!r}")
+    if args.trees is not None and args.trees < 1:
+        raise InputError("--trees", f"must be >= 1, got {args.trees}")
     if args.model == "minirocket":
         _require_sktime()
     from tailbeam.study.learn import learn
@@ -83,7 +94,7 @@ def run(args) -> int:
     test = _samples(args.test, args.model, settings, args.test)[0] if args.test else None
     scores = learn(
         train, args.target, folds=args.folds, sensors=sensors, model=args.model,
-        normalise=args.normalise, test=test, groups=args.groups,
+        normalise=args.normalise, test=test, groups=args.groups, trees=args.trees,
     )  # fmt: skip
     scores["windows"] = settings
     out = Path(args.out) if args.out else folder / "learn"

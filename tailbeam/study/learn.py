@@ -34,12 +34,13 @@ class Samples:
 
 def learn(
     data, target="label", *, folds=5, seed=0, sensors=None, model="forest", normalise=False,
-    test=None, groups="case",
+    test=None, groups="case", trees=None,
 ) -> dict:  # fmt: skip
     """Cross-validated scores of ``model`` and the dummy on ``data`` (Samples, or a feature
     table for the forest), and with ``test`` (Samples, or a list of them) the scores on it of
     both fitted on all of ``data``. ``groups`` names the column whose values never sit on both
     sides of a fold: ``case`` by default; ``source_file`` for cases cut from one recording.
+    ``trees``: the forest's number of trees (``models.TREES`` if None; the forest only).
 
     Returns a dict: model, normalise, target, n_rows, n_cases, folds, sensors, features, and
     for a label "accuracy", "f1_macro", "classes", "confusion" (rows true, columns
@@ -52,6 +53,7 @@ def learn(
     data = data if isinstance(data, Samples) else Samples(data)
     if model not in models.MODELS:
         raise InputError("--model", f"must be one of {models.MODELS}, got {model!r}")
+    trees = _check_trees(trees, model)
     _check_target(data, target)
     inputs = _Inputs(model, data, sensors, normalise)
     tests = [] if test is None else test if isinstance(test, list | tuple) else [test]
@@ -71,10 +73,13 @@ def learn(
     if classify and len(np.unique(y)) < 2:
         raise InputError("--target", f"needs two classes or more, found only {np.unique(y)}")
     cv = GroupKFold(n_splits=folds)
-    pred = cross_val_predict(models.make(model, classify, seed), x, y, groups=group_of, cv=cv)
+    pred = cross_val_predict(
+        models.make(model, classify, seed, trees), x, y, groups=group_of, cv=cv
+    )
     floor = cross_val_predict(models.dummy(classify), x, y, groups=group_of, cv=cv)
     out = {
         "model": model,
+        **({"trees": trees} if model == "forest" else {}),
         "normalise": bool(normalise),
         "target": target,
         "n_rows": len(y),
@@ -87,13 +92,25 @@ def learn(
         "importances": {},
     }
     if model == "forest" or tests:
-        fitted = models.make(model, classify, seed).fit(x, y)
+        fitted = models.make(model, classify, seed, trees).fit(x, y)
         if model == "forest":
             out["importances"] = _importances(fitted[-1], inputs.names)
         scored = [_test_scores(t, target, inputs, fitted, x, y, classify) for t in tests]
         if scored:
             out["test"] = scored if isinstance(test, list | tuple) else scored[0]
     return out
+
+
+def _check_trees(trees, model) -> int:
+    """The forest's number of trees: ``models.TREES`` if None; InputError (``--trees``) for
+    anything but a positive integer, or for trees asked of another model."""
+    if trees is None:
+        return models.TREES
+    if model != "forest":
+        raise InputError("--trees", f"applies to --model forest only, not {model!r}")
+    if isinstance(trees, bool) or not isinstance(trees, int | np.integer) or trees < 1:
+        raise InputError("--trees", f"must be a whole number >= 1, got {trees!r}")
+    return int(trees)
 
 
 def _check_target(samples, target, field="--target"):

@@ -2,8 +2,9 @@
 
 - ``forest``: the feature table's ``<sensor>.<feature>`` columns (tailbeam.study.features)
   through a median imputer (for features undefined on a window, e.g. the decay rate of a
-  window whose loudest frame is its last), a standard scaler and a random forest of 200 trees
-  (classifier for ``label``, regressor for ``gangue_fraction``).
+  window whose loudest frame is its last), a standard scaler and a random forest of
+  ``TREES`` trees unless told otherwise (classifier for ``label``, regressor for
+  ``gangue_fraction``).
 - ``minirocket``: the raw windows the features are computed of, one channel per sensor,
   through sktime's ``MiniRocketMultivariate`` (about 10,000 convolution features: the
   proportion of positive values of random dilated kernels), a standard scaler and a ridge
@@ -23,6 +24,7 @@ import numpy as np
 from tailbeam.study.features import SCALE_FEATURES, is_feature_name
 
 MODELS = ("forest", "minirocket")
+TREES = 200  # the forest's trees by default
 RIDGE_ALPHAS = np.logspace(-3, 3, 10)
 
 
@@ -46,8 +48,8 @@ def normalised(windows) -> np.ndarray:
     return np.divide(w, level, out=np.zeros_like(w), where=level > 0)
 
 
-def forest(classify: bool, seed: int):
-    """Imputer, scaler and random forest (200 trees)."""
+def forest(classify: bool, seed: int, trees: int = TREES):
+    """Imputer, scaler and random forest of ``trees`` trees."""
     from sklearn.ensemble import RandomForestClassifier, RandomForestRegressor
     from sklearn.impute import SimpleImputer
     from sklearn.pipeline import make_pipeline
@@ -57,7 +59,7 @@ def forest(classify: bool, seed: int):
     return make_pipeline(
         SimpleImputer(strategy="median"),
         StandardScaler(),
-        model(n_estimators=200, random_state=seed, n_jobs=1),
+        model(n_estimators=trees, random_state=seed, n_jobs=1),
     )
 
 
@@ -98,9 +100,11 @@ def _rocket_step():
     return MiniRocketFeatures
 
 
-def make(kind: str, classify: bool, seed: int):
-    """The pipeline of model ``kind`` (one of MODELS)."""
-    return {"forest": forest, "minirocket": minirocket}[kind](classify, seed)
+def make(kind: str, classify: bool, seed: int, trees: int = TREES):
+    """The pipeline of model ``kind`` (one of MODELS); ``trees``: the forest's."""
+    if kind == "forest":
+        return forest(classify, seed, trees)
+    return minirocket(classify, seed)
 
 
 def dummy(classify: bool):
