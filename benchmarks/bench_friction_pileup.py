@@ -18,8 +18,8 @@ exponent of wall and CPU time against the number of lumps; ``--one-set`` integra
 active set as one set (a private switch, ``loop._ISLANDS``) in place of its islands.
 ``--compare`` adds the same short pile with sleeping disabled (full integration of the
 resting lumps) and the differences of the final positions and energy. Writes
-DIR/table.md and DIR/results.json; prints the machine's load (``os.getloadavg``) before and
-after: the machine may be shared.
+DIR/table.md and DIR/results.json (DIR/rows.json after each case); prints the machine's
+load (``os.getloadavg``) before and after: the machine may be shared.
 """
 
 import argparse
@@ -140,8 +140,11 @@ def main(argv=None) -> int:
     for n in counts:
         row = _in_child(n, True, 1.0, not args.one_set)
         rows.append(row)
-        print(f"{n} lumps: {row['wall_s']:.1f} s, asleep {row['at_rest_fraction']:.2f}, "
-              f"energy residual {row['energy_residual']:.3g} J", file=sys.stderr)  # fmt: skip
+        print(f"{n} lumps: {row['wall_s']:.1f} s, {row['cpu_s']:.1f} s CPU, asleep "
+              f"{row['at_rest_fraction']:.2f}, energy residual {row['energy_residual']:.3g} J",
+              file=sys.stderr)  # fmt: skip
+        partial = [{k: v for k, v in r.items() if k != "final"} for r in rows]
+        (args.out / "rows.json").write_text(json.dumps(partial, indent=1))  # (as they come)
     result = {"rows": [{k: v for k, v in r.items() if k != "final"} for r in rows]}
     if len(rows) >= 2:
         lumps = np.log([r["lumps"] for r in rows])
