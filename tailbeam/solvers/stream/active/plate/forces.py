@@ -73,10 +73,14 @@ class PlateForces:
             return
         codes = rows[:, 1].astype(np.int64)
         npairs = len(keys)
-        for code in np.unique(codes):
+        order = np.argsort(codes, kind="stable")  # (each code's rows in the order written)
+        sorted_codes = codes[order]
+        starts = np.flatnonzero(np.diff(sorted_codes)) + 1
+        for run in np.split(order, starts):
+            code = int(codes[run[0]])
             p, part = code % npairs, code // npairs
             i = keys[p][0]
-            sel = rows[codes == code]
+            sel = rows[run]
             entry = self.nodes.get(i)
             if entry is None:
                 x = s.x[local[i]]
