@@ -129,6 +129,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="counts 25 50 100")
     ap.add_argument("--compare", type=int, default=0, metavar="N",
                     help="also run N lumps with sleeping off and compare")  # fmt: skip
+    ap.add_argument("--compare-extra", type=float, default=0.5, metavar="S",
+                    help="the compared runs last S s past the stream (default 0.5)")  # fmt: skip
     ap.add_argument("--one-set", action="store_true",
                     help="integrate the active set as one set, not as islands")  # fmt: skip
     args = ap.parse_args(argv)
@@ -151,7 +153,8 @@ def main(argv=None) -> int:
         for key, col in (("cost_exponent", "wall_s"), ("cpu_exponent", "cpu_s")):
             result[key] = float(np.polyfit(lumps, np.log([r[col] for r in rows]), 1)[0])
     if args.compare:
-        on, off = _in_child(args.compare, True, 0.5), _in_child(args.compare, False, 0.5)
+        extra = args.compare_extra
+        on, off = _in_child(args.compare, True, extra), _in_child(args.compare, False, extra)
         result["compare"] = {"sleep": {k: v for k, v in on.items() if k != "final"},
                              "no_sleep": {k: v for k, v in off.items() if k != "final"},
                              **compare(on, off)}  # fmt: skip

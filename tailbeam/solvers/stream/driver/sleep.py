@@ -133,22 +133,13 @@ class Sleepers:
         _, v = self.act.state(i)
         return float(v @ v) < SLEEP_SPEED * SLEEP_SPEED
 
-    def _creep(self, key) -> tuple:
-        """(slip speed, rolling speed) m/s at contact ``key`` now: the slip at the model's
-        contact point and the rolling radius x the relative angular velocity's part in the
-        contact plane (twisting about the normal is free: not looked at)."""
+    def _slip(self, key) -> float:
+        """Slip speed (m/s) at the model's contact point of contact ``key`` now."""
         act = self.act
         a, c = key
         xa, va = act.state(a)
-        wa = act.spin(a)
-        if c < 0:
-            partner, n, w = (), np.array([0.0, 0.0, 1.0]), wa
-        else:
-            xc, vc = act.state(c)
-            wc = act.spin(c)
-            partner, n, w = (xc, vc, wc), (xa - xc) / np.linalg.norm(xa - xc), wa - wc
-        roll = act.friction.row(key)[6] * float(np.linalg.norm(w - (w @ n) * n))
-        return act.friction.slip(key, xa, va, wa, *partner), roll
+        partner = () if c < 0 else (*act.state(c), act.spin(c))
+        return act.friction.slip(key, xa, va, act.spin(a), *partner)
 
     def _clusters(self, ready, touching):
         """Connected clusters (sorted ball list, their touching keys) of touching balls
@@ -184,7 +175,7 @@ class Sleepers:
         for key in keys:
             s, row = self.act.friction.settings(key), self.act.friction.row(key)
             mu = s.static
-            if self._creep(key)[0] >= s.stiction_velocity:
+            if self._slip(key) >= s.stiction_velocity:
                 mu = min(s.static, s.dynamic)
             i, j = key
             rows.append((local[i], -1 if j < 0 else local[j], row[5], mu, s.rolling, row[6]))
