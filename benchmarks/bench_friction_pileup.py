@@ -18,8 +18,8 @@ exponent of wall and CPU time against the number of lumps; ``--one-set`` integra
 active set as one set (a private switch, ``loop._ISLANDS``) in place of its islands.
 ``--compare`` adds the same short pile with sleeping disabled (full integration of the
 resting lumps) and the differences of the final positions and energy. Writes
-DIR/table.md and DIR/results.json; prints the machine's load (``os.getloadavg``) before and
-after: the machine may be shared.
+DIR/table.md and DIR/results.json (DIR/rows.json after each case); prints the machine's
+load (``os.getloadavg``) before and after: the machine may be shared.
 """
 
 import argparse
@@ -129,6 +129,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="counts 25 50 100")
     ap.add_argument("--compare", type=int, default=0, metavar="N",
                     help="also run N lumps with sleeping off and compare")  # fmt: skip
+    ap.add_argument("--compare-extra", type=float, default=0.5, metavar="S",
+                    help="the compared runs last S s past the stream (default 0.5)")  # fmt: skip
     ap.add_argument("--one-set", action="store_true",
                     help="integrate the active set as one set, not as islands")  # fmt: skip
     args = ap.parse_args(argv)
@@ -140,15 +142,19 @@ def main(argv=None) -> int:
     for n in counts:
         row = _in_child(n, True, 1.0, not args.one_set)
         rows.append(row)
-        print(f"{n} lumps: {row['wall_s']:.1f} s, asleep {row['at_rest_fraction']:.2f}, "
-              f"energy residual {row['energy_residual']:.3g} J", file=sys.stderr)  # fmt: skip
+        print(f"{n} lumps: {row['wall_s']:.1f} s, {row['cpu_s']:.1f} s CPU, asleep "
+              f"{row['at_rest_fraction']:.2f}, energy residual {row['energy_residual']:.3g} J",
+              file=sys.stderr)  # fmt: skip
+        partial = [{k: v for k, v in r.items() if k != "final"} for r in rows]
+        (args.out / "rows.json").write_text(json.dumps(partial, indent=1))  # (as they come)
     result = {"rows": [{k: v for k, v in r.items() if k != "final"} for r in rows]}
     if len(rows) >= 2:
         lumps = np.log([r["lumps"] for r in rows])
         for key, col in (("cost_exponent", "wall_s"), ("cpu_exponent", "cpu_s")):
             result[key] = float(np.polyfit(lumps, np.log([r[col] for r in rows]), 1)[0])
     if args.compare:
-        on, off = _in_child(args.compare, True, 0.5), _in_child(args.compare, False, 0.5)
+        extra = args.compare_extra
+        on, off = _in_child(args.compare, True, extra), _in_child(args.compare, False, extra)
         result["compare"] = {"sleep": {k: v for k, v in on.items() if k != "final"},
                              "no_sleep": {k: v for k, v in off.items() if k != "final"},
                              **compare(on, off)}  # fmt: skip

@@ -6,8 +6,9 @@ struck ball never slept.
 
 Coal balls, r = 30 mm, v_s = 1e-3 m/s, v_d = 2e-3 m/s, rtol 1e-10, set down at their static
 penetration. The bound on a frozen ball's displacement is the creep it can make before it is
-frozen: slip plus rolling, each below v_s, for SLEEP_DWELL plus one refresh interval
-(SET_HORIZON).
+frozen: slip plus rolling, each below v_s at a contact within its limits (the rule itself
+asks only a centre slower than the rest speed: ``test_friction_rest_heap``), for
+SLEEP_DWELL plus one refresh interval (SET_HORIZON).
 """
 
 import math
@@ -31,7 +32,8 @@ G = STANDARD_GRAVITY
 R = 0.03
 COAL = get_material("coal")
 V_S = 1e-3
-# m: the most a ball creeps before it is frozen: slip plus rolling, each below v_s
+# m: the most a ball creeps before it is frozen where its contacts are within their limits:
+# slip plus rolling, each below v_s
 CREEP_BOUND = 2.0 * V_S * (SLEEP_DWELL + SET_HORIZON)
 
 

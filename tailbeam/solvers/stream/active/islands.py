@@ -64,6 +64,7 @@ class Islands:
         self.of = {}  # ball -> its island
         self._now = 0.0
         self.forces = self._new().forces
+        self.forces.pending = self._flush_of
         self.valid_until = -np.inf  # s: the grouping's horizon (stale: -inf)
         self.queued = []  # events of other islands at the instant last returned
         self.newcomers = None  # the island of the balls joining since the last call
@@ -74,6 +75,7 @@ class Islands:
 
     def _new(self) -> ActiveMembers:
         act = ActiveMembers(self.balls, self.rtol, self.settle_energy, friction=self.friction)
+        act.lazy_forces = True
         if hasattr(self, "forces"):
             act.forces = self.forces
         act.now = self._now
@@ -110,7 +112,14 @@ class Islands:
         if not isl.members:
             self._retire(isl)
 
+    def _flush_of(self, i: int) -> None:
+        """The force rows of ball i's island into the histories (before i's are taken)."""
+        isl = self.of.get(i)
+        if isl is not None:
+            isl.flush_forces()
+
     def _retire(self, isl) -> None:
+        isl.flush_forces()
         for key, value in isl.stats().items():
             self.retired[key] += value
         self.islands.remove(isl)
@@ -152,15 +161,17 @@ class Islands:
         return self.of[balls[0]]
 
     # --- grouping ---------------------------------------------------------------------------
-    def speed_bounds(self, groups, horizon: float) -> dict:
+    def speed_bounds(self, groups, horizon: float, energy=None) -> dict:
         """Ball -> speed bound (m/s) over ``horizon`` (s) while its group touches no other:
         the group's as an isolated group (``reach.group_speed_bounds``: its kinetic, rotation
         included, and elastic energy plus the work gravity can do on it within the
-        horizon)."""
+        horizon). ``energy``: ball -> its share of that energy now (``ball_energies``; None:
+        computed here)."""
         b = self.balls
         g = float(np.linalg.norm(b.g))
-        balls = [i for grp in groups for i in grp]
-        energy = dict(zip(balls, self.ball_energies(balls).tolist(), strict=True))
+        if energy is None:
+            balls = [i for grp in groups for i in grp]
+            energy = dict(zip(balls, self.ball_energies(balls).tolist(), strict=True))
         out = {}
         for grp in groups:
             pooled = sum(energy[i] for i in grp)
@@ -200,9 +211,10 @@ class Islands:
         x = self.positions(m)
         r = self.balls.radius[m]
         d2 = np.sum((x[:, None, :] - x[None, :, :]) ** 2, axis=2)
+        energy = dict(zip(m, self.ball_energies(m).tolist(), strict=True))
         while True:
             groups = _groups(m, [find(q) for q in range(len(m))])
-            s = self.speed_bounds(groups, horizon)
+            s = self.speed_bounds(groups, horizon, energy)
             sv = np.array([s[i] for i in m])
             reach = r[:, None] + r[None, :] + (sv[:, None] + sv[None, :]) * horizon
             qi, qj = np.nonzero(np.triu(d2 <= reach**2, 1))

@@ -30,6 +30,8 @@ from tailbeam.solvers.stream.active.plate.forces import THIN, THIN_FRICTION, Pla
 from tailbeam.solvers.stream.active.plate.pairs import PlatePairs
 from tailbeam.solvers.stream.active.plate.rest import excess_energy, place_at_rest, static_height
 
+LAZY_ROWS = 50_000  # with ``lazy_forces``: force rows a set holds before they are drained
+
 
 class ActiveMembers:
     """The members of the active set and their pairs, by ball number and pair key.
@@ -76,6 +78,7 @@ class ActiveMembers:
         self.modal = None if plate is None else PlatePairs(plate, balls, rtol, dead_loads)
         thin = (0.0, 0.0) if friction is None else (THIN, THIN_FRICTION)
         self.forces = PlateForces(self._friction_lever(), thin)
+        self.lazy_forces = False  # True: force rows drained only when needed (flush_forces)
         self.carried = CarriedRows()
         self.now = 0.0
         self.members, self.quiet = [], set()  # quiet: members resting on the plate
@@ -190,7 +193,18 @@ class ActiveMembers:
         self.carried.rows = [r for p in parts if p["carried"][0] == t for r in p["carried"][1]]
         self.dirty = True
 
+    def flush_forces(self) -> None:
+        """Move the force rows the built set still holds into the histories (``forces``;
+        with ``lazy_forces`` they wait there until a ball's history is taken, the set is
+        rebuilt or dropped, or LAZY_ROWS have gathered)."""
+        s = self.set
+        if s is None or not len(s.force_rows()):
+            return
+        self.forces.drain(s, self.keys, self.local)
+        s.io.clear_rows()
+
     def _build(self):
+        self.flush_forces()  # (the rows name the pairs of the set replaced)
         b, m = self.balls, self.members
         old = self._pairs
         self.keys = [(i, -1) for i in m] + self._ball_pairs(old)
@@ -320,9 +334,11 @@ class ActiveMembers:
         """Take the force rows and kinks of the calls since the last report and translate
         ``out`` (an ``Outcome``) as ``next_event`` returns it."""
         s = self.set
-        self.forces.drain(s, self.keys, self.local)
+        rows = not self.lazy_forces or len(s.force_rows()) > LAZY_ROWS
+        if rows:
+            self.forces.drain(s, self.keys, self.local)
         self.kinks = [(t_k, kind, self.keys[p]) for t_k, kind, p in s.kink_log()]
-        s.clear_outputs()
+        s.clear_outputs(rows)
         if self.plate is not None:
             n = self.plate.n_modes
             self.plate.take(s.q[:n], s.qd[:n], out.t)
@@ -383,11 +399,14 @@ class ActiveMembers:
         out = 0.5 * m * np.sum(s.v[q] * s.v[q], axis=1)
         if self.friction is not None:
             out += 0.2 * m * s.model.radius[q] ** 2 * np.sum(s.w[q] * s.w[q], axis=1)
+        touching = np.flatnonzero(s.contacts.touching)
+        if not len(touching):
+            return out
+        energies = s.contact_energies()
         where = {int(i): k for k, i in enumerate(balls)}
-        for p in np.flatnonzero(s.contacts.touching):
+        for p in touching.tolist():
             i, j = self.keys[p]
-            share = 1.0 if j < 0 else 0.5
-            e = share * s.contact_energy(p)
+            e = energies[p] if j < 0 else 0.5 * energies[p]
             for k in (i, j):
                 if k in where:
                     out[where[k]] += e

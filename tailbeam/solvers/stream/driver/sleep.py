@@ -5,18 +5,21 @@ regularised law holds a ball by a creep below the stiction velocity v_s, so a re
 would be integrated (and creep) for as long as it rests. Instead, at every refresh of the
 active set (at least every ``membership.SET_HORIZON``):
 
-* a core ball is SLOW while its centre speed is below SLEEP_SPEED (the frictionless rest
-  speed: what is left then is mostly the normal oscillation of its contacts, lightly damped
-  at the static penetration, and the creep of the regularised law) and the slip and rolling
-  speeds at each of its touching contacts are below their smallest stiction velocity v_s
-  (a spin about a contact normal, free in the model, is not looked at and is dropped when
-  the ball is frozen);
+* a core ball is SLOW while it touches something and its centre speed is below SLEEP_SPEED
+  (the frictionless rest speed: what is left then is mostly the normal oscillation of its
+  contacts, lightly damped at the static penetration, and the creep of the regularised law,
+  slip plus rolling at each contact; a spin, about a contact normal or not, is not looked
+  at and is dropped when the ball is frozen);
 * a CLUSTER is a connected set of core balls through touching ball-ball contacts, at least
   one of them touching the plate; it is frozen when every ball of it has been slow for
   SLEEP_DWELL, no core ball left awake could reach it within the set's horizon (it would be
   woken at once: it waits, ready, counted in ``sleep_deferred``), and the rigid statics of
   its contacts admit equilibrium within the Coulomb and rolling limits
-  (``statics.in_equilibrium``; refused: slow again from now);
+  (``statics.in_equilibrium``; a contact slipping at its stiction velocity or faster is
+  held to min(mu_s, mu_d), what sliding friction gives; refused: slow again from now). The
+  statics, not the creep speeds, say whether the cluster can stand: in a statically
+  indeterminate heap the regularised law creeps on at some contacts above v_s while a set
+  of forces within the limits exists;
 * frozen, its balls leave the active set and are ASLEEP (``balls.SLEEP``): velocity and
   angular velocity exactly zero, position fixed, their contacts at the penetrations they
   had (their records end as ``rest``; the kinetic energy dropped is counted in
@@ -123,31 +126,20 @@ class Sleepers:
         return out
 
     def _is_slow(self, i: int, keys) -> bool:
-        """Ball i touches something (``keys``), its centre moves slower than SLEEP_SPEED,
-        and the slip speed and the rolling speed (rolling radius x the relative angular
-        velocity's part in the contact plane) at each of its contacts are below the
-        contacts' smallest stiction velocity (twisting about a normal is free: not looked
-        at)."""
-        act = self.act
+        """Ball i touches something (``keys``) and its centre moves slower than SLEEP_SPEED.
+        How its contacts creep is left to the statics (``_holds``)."""
         if not keys:
             return False
-        v_s = min(act.friction.settings(k).stiction_velocity for k in keys)
-        _, v = act.state(i)
-        if float(np.linalg.norm(v)) >= SLEEP_SPEED:
-            return False
-        for a, c in keys:
-            xa, va = act.state(a)
-            wa = act.spin(a)
-            if c < 0:
-                partner, n, w = (), np.array([0.0, 0.0, 1.0]), wa
-            else:
-                xc, vc = act.state(c)
-                wc = act.spin(c)
-                partner, n, w = (xc, vc, wc), (xa - xc) / np.linalg.norm(xa - xc), wa - wc
-            roll = act.friction.row((a, c))[6] * float(np.linalg.norm(w - (w @ n) * n))
-            if roll >= v_s or act.friction.slip((a, c), xa, va, wa, *partner) >= v_s:
-                return False
-        return True
+        _, v = self.act.state(i)
+        return float(v @ v) < SLEEP_SPEED * SLEEP_SPEED
+
+    def _slip(self, key) -> float:
+        """Slip speed (m/s) at the model's contact point of contact ``key`` now."""
+        act = self.act
+        a, c = key
+        xa, va = act.state(a)
+        partner = () if c < 0 else (*act.state(c), act.spin(c))
+        return act.friction.slip(key, xa, va, act.spin(a), *partner)
 
     def _clusters(self, ready, touching):
         """Connected clusters (sorted ball list, their touching keys) of touching balls
@@ -174,14 +166,19 @@ class Sleepers:
         return out
 
     def _holds(self, comp, keys) -> bool:
-        """The rigid statics of cluster ``comp`` admit equilibrium (``statics``)."""
+        """The rigid statics of cluster ``comp`` admit equilibrium (``statics``): a contact
+        that slips at its stiction velocity or faster is held to the least friction the law
+        gives a sliding contact, min(mu_s, mu_d) (sliding friction cannot hold more)."""
         local = {i: q for q, i in enumerate(comp)}
         x = np.array([self.act.state(i)[0] for i in comp])
         rows = []
         for key in keys:
             s, row = self.act.friction.settings(key), self.act.friction.row(key)
+            mu = s.static
+            if self._slip(key) >= s.stiction_velocity:
+                mu = min(s.static, s.dynamic)
             i, j = key
-            rows.append((local[i], -1 if j < 0 else local[j], row[5], s.static, s.rolling, row[6]))
+            rows.append((local[i], -1 if j < 0 else local[j], row[5], mu, s.rolling, row[6]))
         b = self.balls
         return in_equilibrium(x, b.mass[comp], b.g, rows)
 

@@ -126,6 +126,20 @@ def plate_contact_energy(delta0, k, e, cres):
 
 
 @helper_njit
+def contact_energies(y, n, pi, pj, rsum, phi, law, touching, out):
+    """Elastic energy (J) of every pair at state y into ``out`` (P,): ``plate_contact_energy``
+    of a touching plate pair (its residual spring included), that of the law for two balls,
+    0 for a pair not touching (``ActiveSet.contact_energy`` for all pairs in one call)."""
+    for p in range(pi.shape[0]):
+        out[p] = 0.0
+        if not touching[p]:
+            continue
+        delta, _, _, _, _ = pair_state(y, n, pi[p], pj[p], rsum[p], phi, p)
+        cres = law[p, L_CRES] if pj[p] < 0 else 0.0
+        out[p] = plate_contact_energy(delta, law[p, LAW_K], law[p, LAW_E], cres)
+
+
+@helper_njit
 def plate_free_acceleration(y, n, p, i, phi, mass, g, omega, zeta, fdead):
     """(acc0 m/s^2, kappa 1/kg) of plate pair p of ball i at state y: delta0'' = acc0 -
     kappa F without the other contacts, acc0 = -g_z + phi[p] . (f_dead - 2 zeta omega q' -

@@ -94,10 +94,15 @@ class KernelIO:
         out = self.log[: self.iout[ak.IO_LOG]]
         return [(float(t), EventCode(int(k)).kind, int(p)) for t, k, p in out]
 
-    def clear_outputs(self) -> None:
-        """Forget the force rows and the kink log (the caller has consumed them)."""
-        self.iout[ak.IO_ROWS] = 0
+    def clear_outputs(self, rows: bool = True) -> None:
+        """Forget the kink log and (``rows``) the force rows: the caller has consumed them."""
+        if rows:
+            self.clear_rows()
         self.iout[ak.IO_LOG] = 0
+
+    def clear_rows(self) -> None:
+        """Forget the force rows (the caller has consumed them)."""
+        self.iout[ak.IO_ROWS] = 0
 
     @property
     def stats(self) -> dict:

@@ -54,7 +54,12 @@ from tailbeam.physics.contacts import PLATE, ContactTable, LawOptions
 from tailbeam.solvers.numerics.chebyshev import tables as cheb_tables
 from tailbeam.solvers.numerics.dop853 import dop853_tables
 from tailbeam.solvers.stream.active.compiled import kernel as ak
-from tailbeam.solvers.stream.active.compiled.pairs import L_CRES, pair_state, plate_contact_energy
+from tailbeam.solvers.stream.active.compiled.pairs import (
+    L_CRES,
+    contact_energies,
+    pair_state,
+    plate_contact_energy,
+)
 from tailbeam.solvers.stream.active.integrator.contact_states import ContactStates
 from tailbeam.solvers.stream.active.integrator.kernel_io import KernelIO, Outcome
 from tailbeam.solvers.stream.active.integrator.modal_block import ModalBlock
@@ -228,6 +233,14 @@ class ActiveSet:
         k, e, cres = law[p, LAW_K], law[p, LAW_E], law[p, L_CRES]
         return float(plate_contact_energy(delta, k, e, cres if self.model.pj[p] < 0 else 0.0))
 
+    def contact_energies(self) -> np.ndarray:
+        """Elastic energy (J, (P,)) of every pair now: ``contact_energy`` of each."""
+        m = self.model
+        out = np.zeros(len(m.pi))
+        contact_energies(self.y, len(m.mass), m.pi, m.pj, m.rsum, m.phi, m.law,
+                         self.contacts.touching, out)  # fmt: skip
+        return out
+
     def modal_energy(self) -> float:
         """Kinetic + strain energy of the modes now, J: 1/2 (q'^2 + omega^2 q^2) summed."""
         return float(0.5 * np.sum(self.qd**2 + (self.model.omega * self.q) ** 2))
@@ -320,9 +333,11 @@ class ActiveSet:
         """(t s, ``EventKind``, pair) of the kinks handled inside so far."""
         return self.io.kink_log()
 
-    def clear_outputs(self):
-        """Forget the force rows and the kink log (the caller has consumed them)."""
-        self.io.clear_outputs()
+    def clear_outputs(self, rows: bool = True):
+        """Forget the kink log and (``rows``) the force rows: the caller has consumed them.
+        Rows kept stay in the buffer for a later call's rows to follow them (``restore``
+        keeps those written before its ``snapshot``)."""
+        self.io.clear_outputs(rows)
 
     @property
     def stats(self) -> dict:

@@ -2,7 +2,8 @@
 
 The compiled set writes force rows (t, pair, F) of its touching plate pairs: at interior
 points of every accepted step and at contact starts and ends. They are drained after each
-``advance`` into one history per ball, held at the point of its first row, until the driver
+``advance`` (the islands: when a ball's history is taken, ``pending``) into one history
+per ball, held at the ball's position when its first rows are drained, until the driver
 takes it as a load (a contact ended, the ball left the set or the run ended).
 
 With friction on the modal plate the set also writes the friction force F_t on the ball
@@ -13,16 +14,17 @@ on its top surface, h/2 above its mid-surface: the modes feel (h/2) F_t . grad p
 are (h/2) F_t . grad phi with grad phi a central difference of step e (relative error
 ~(k e)^2 / 6 for a mode of wavenumber k, as ``StreamPlate.gradients``).
 
-With friction each drained piece of a history (one ``advance`` call's rows of one pair and
-part) is thinned (``thinning.keep_nodes``) to within a fraction of its largest magnitude
-(THIN of the contact force's, THIN_FRICTION of a friction component's): the stiff steps of
-a sticking impact write 40 nodes per step, far more than the force needs, and the friction
-rows wobble at the scale of those steps (the slip held below vs by a step bounded by
-stability), so they thin only at a coarser tolerance. Measured on the caving stream's first
-100 particles on the modal plate (``benchmarks/bench_friction_stream.py``): 1.56 million
-load nodes in place of 10.8 million; the sensors' signals moved by 3.8e-6 of their largest
-value (RMS of the change: 1.3e-6 of the signal's). Without friction every row is kept, as
-written.
+With friction each drained piece of a history (the rows of one pair and part drained at
+once: one ``advance`` call's, or with the islands' lazy draining those of the calls since
+the last drain, ``ActiveMembers.flush_forces``) is thinned (``thinning.keep_nodes``) to
+within a fraction of its largest magnitude (THIN of the contact force's, THIN_FRICTION of a
+friction component's): the stiff steps of a sticking impact write 40 nodes per step, far
+more than the force needs, and the friction rows wobble at the scale of those steps (the
+slip held below vs by a step bounded by stability), so they thin only at a coarser
+tolerance. Measured on the caving stream's first 100 particles on the modal plate
+(``benchmarks/bench_friction_stream.py``): 1.56 million load nodes in place of 10.8 million;
+the sensors' signals moved by 3.8e-6 of their largest value (RMS of the change: 1.3e-6 of
+the signal's). Without friction every row is kept, as written.
 """
 
 import numpy as np
@@ -52,6 +54,7 @@ class PlateForces:
         self.lever, self.thin = float(lever), tuple(float(v) for v in thin)
         # ball -> [x, y, [t], [F], [t of F_x], [F_x], [t of F_y], [F_y]] (lists of arrays)
         self.nodes = {}
+        self.pending = None  # ball -> None: drains rows of the ball still held elsewhere
 
     def drain(self, s, keys, local) -> None:
         """Move the force rows of ``s`` (an ``ActiveSet``) into the histories.
@@ -70,10 +73,14 @@ class PlateForces:
             return
         codes = rows[:, 1].astype(np.int64)
         npairs = len(keys)
-        for code in np.unique(codes):
+        order = np.argsort(codes, kind="stable")  # (each code's rows in the order written)
+        sorted_codes = codes[order]
+        starts = np.flatnonzero(np.diff(sorted_codes)) + 1
+        for run in np.split(order, starts):
+            code = int(codes[run[0]])
             p, part = code % npairs, code // npairs
             i = keys[p][0]
-            sel = rows[codes == code]
+            sel = rows[run]
             entry = self.nodes.get(i)
             if entry is None:
                 x = s.x[local[i]]
@@ -95,6 +102,8 @@ class PlateForces:
             (x m, y m, t_nodes (k,) s, forces (k,) N) in time order, none for a history that
             is empty or spans a single instant (a contact flushed as it started).
         """
+        if self.pending is not None:
+            self.pending(i)
         entry = self.nodes.pop(i, None)
         if entry is None:
             return []
