@@ -73,14 +73,12 @@ def run(args) -> int:
         raise InputError("--folds", f"must be >= 2, got {args.folds}")
     if args.model not in MODELS:
         raise InputError("--model", f"must be one of {MODELS}, got {args.model!r}")
-    if args.trees is not None and args.model != "forest":
-        raise InputError("--trees", f"applies to --model forest only, not {args.model!r}")
-    if args.trees is not None and args.trees < 1:
-        raise InputError("--trees", f"must be >= 1, got {args.trees}")
+    from tailbeam.study.learn import check_trees, learn
+    from tailbeam.study.windows import open_dataset
+
+    check_trees(args.trees, args.model)  # (before any dataset is read)
     if args.model == "minirocket":
         _require_sktime()
-    from tailbeam.study.learn import learn
-    from tailbeam.study.windows import open_dataset
 
     ds, folder = open_dataset(args.dataset)
     sensors = args.sensors.split(",") if args.sensors else None

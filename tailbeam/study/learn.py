@@ -53,7 +53,7 @@ def learn(
     data = data if isinstance(data, Samples) else Samples(data)
     if model not in models.MODELS:
         raise InputError("--model", f"must be one of {models.MODELS}, got {model!r}")
-    trees = _check_trees(trees, model)
+    trees = check_trees(trees, model)
     _check_target(data, target)
     inputs = _Inputs(model, data, sensors, normalise)
     tests = [] if test is None else test if isinstance(test, list | tuple) else [test]
@@ -101,7 +101,7 @@ def learn(
     return out
 
 
-def _check_trees(trees, model) -> int:
+def check_trees(trees, model) -> int:
     """The forest's number of trees: ``models.TREES`` if None; InputError (``--trees``) for
     anything but a positive integer, or for trees asked of another model."""
     if trees is None:
@@ -109,7 +109,7 @@ def _check_trees(trees, model) -> int:
     if model != "forest":
         raise InputError("--trees", f"applies to --model forest only, not {model!r}")
     if isinstance(trees, bool) or not isinstance(trees, int | np.integer) or trees < 1:
-        raise InputError("--trees", f"must be a whole number >= 1, got {trees!r}")
+        raise InputError("--trees", f"must be >= 1 (a whole number), got {trees!r}")
     return int(trees)
 
 

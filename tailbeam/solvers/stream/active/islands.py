@@ -161,17 +161,13 @@ class Islands:
         return self.of[balls[0]]
 
     # --- grouping ---------------------------------------------------------------------------
-    def speed_bounds(self, groups, horizon: float, energy=None) -> dict:
+    def speed_bounds(self, groups, horizon: float, energy: dict) -> dict:
         """Ball -> speed bound (m/s) over ``horizon`` (s) while its group touches no other:
         the group's as an isolated group (``reach.group_speed_bounds``: its kinetic, rotation
         included, and elastic energy plus the work gravity can do on it within the
-        horizon). ``energy``: ball -> its share of that energy now (``ball_energies``; None:
-        computed here)."""
+        horizon). ``energy``: ball -> its share of that energy now (``ball_energies``)."""
         b = self.balls
         g = float(np.linalg.norm(b.g))
-        if energy is None:
-            balls = [i for grp in groups for i in grp]
-            energy = dict(zip(balls, self.ball_energies(balls).tolist(), strict=True))
         out = {}
         for grp in groups:
             pooled = sum(energy[i] for i in grp)
