@@ -21,6 +21,7 @@ Running one scene through two solvers is how a user checks one against the other
 import contextlib
 
 from tailbeam.errors import InputError
+from tailbeam.plate.blas import limited
 from tailbeam.progress import quiet
 from tailbeam.results.frames import check_frame_times
 from tailbeam.scene import Scene
@@ -51,6 +52,8 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True, 
         Step budget (rigid: per ball; stream solver: in all); WorkLimitError beyond it.
     progress : bool
         Show progress and the automatic choices on stderr (``tailbeam.progress``).
+        The run holds BLAS to one thread, or ``$TAILBEAM_BLAS_THREADS``
+        (``tailbeam.plate.blas``), and restores the caller's limit after it.
     frames : sequence of float
         Times (s, increasing, within [0, duration]) at which the result keeps every body's
         position and velocity (``result.frames``, ``tailbeam.results.frames``); memory
@@ -71,7 +74,7 @@ def simulate(scene, *, solver="auto", rtol=None, max_steps=None, progress=True, 
     if frames and not method.frames:
         raise InputError("frames", f"the {method.name!r} solver keeps no states at frame times")
     options = Options(rtol=rtol, max_steps=max_steps, frames=frames)
-    with contextlib.nullcontext() if progress else quiet():
+    with contextlib.nullcontext() if progress else quiet(), limited():
         method.check(scene, options)
         cost = announce_run(scene, method)
         result = method.run(scene, plate_setup(scene, method), options)

@@ -24,6 +24,7 @@ from scipy.linalg import eigh
 
 from tailbeam.errors import InputError, WorkLimitError, require_nonnegative, require_positive
 from tailbeam.plate.basis import ModalBasis
+from tailbeam.plate.blas import limited
 from tailbeam.plate.fe.model import check_points
 
 MAX_RITZ_VECTORS = 1024  # k x points: memory n_dofs x this x 8 B (250 MB at 30 000 DOFs)
@@ -89,7 +90,12 @@ class KrylovTail:
         self.exhausted = False
 
     def extend(self, k: int) -> None:
-        """Grow the space to k Krylov steps (or until it is exhausted)."""
+        """Grow the space to k Krylov steps (or until it is exhausted), under the basis
+        builds' BLAS thread limit (``tailbeam.plate.blas``)."""
+        with limited():
+            self._extend(k)
+
+    def _extend(self, k: int) -> None:
         solve = self.model.solver().solve
         if self.block is None:
             self.block = solve(self.loads)
@@ -128,8 +134,9 @@ class KrylovTail:
         if count == 0:  # the loads move no truncated mode
             return np.zeros(0), self.buf[:, :0]
         V = self.buf[:, :count]
-        theta, Y = eigh(V.T @ (self.model.stiffness @ V), V.T @ self.mbuf[:, :count])
-        return np.sqrt(theta), V @ Y
+        with limited():
+            theta, Y = eigh(V.T @ (self.model.stiffness @ V), V.T @ self.mbuf[:, :count])
+            return np.sqrt(theta), V @ Y
 
 
 _MASS_KEPT: dict = {}  # id(Phi_kept) -> (Phi_kept, M Phi_kept), the last KRYLOV_MEMO

@@ -16,6 +16,7 @@ from tailbeam.errors import InputError, WorkLimitError, require_positive
 from tailbeam.physics.bodies import Plate
 from tailbeam.plate import cache as modal_cache
 from tailbeam.plate.basis import ModalBasis
+from tailbeam.plate.blas import blas_threads as blas_threads_limit
 from tailbeam.plate.closed_forms import bending_wavenumber, ssss_kirchhoff_frequencies
 from tailbeam.plate.fe.boundary import EDGES, describe, parse_boundary, rigid_body_mode_count
 from tailbeam.plate.fe.cost import SolveCost, check_cost, mesh_dofs, solve_cost
@@ -29,18 +30,6 @@ from tailbeam.progress import task
 MAX_COUNT = 10_000  # modes: far beyond any band this package is meant for
 MAX_SOLVE_ROUNDS = 5  # enlarging the number of requested modes until the band is covered
 _WEYL_EDGE = {"S": -1.0, "C": -1.0, "F": 1.0}  # boundary term per edge, in units of L k/(4 pi)
-
-
-def _blas_threads(requested):
-    """Thread limit for BLAS inside the solve: the keyword, else $TAILBEAM_BLAS_THREADS, else
-    1. The shift-invert solves (SuperLU) are single-threaded anyway; more BLAS threads only
-    speed up the Lanczos orthogonalisation, and on a loaded machine they slowed the whole
-    solve several-fold (default plate to 10 kHz: 23 s with two OpenBLAS threads, 3 s with
-    one)."""
-    if requested is not None:
-        return int(requested)
-    env = os.environ.get("TAILBEAM_BLAS_THREADS")
-    return int(env) if env else 1
 
 
 def _estimated_count(plate: Plate, boundary: str, theory: str, fmax_hz: float) -> int:
@@ -302,7 +291,7 @@ def compute_modes(
     mesh: a mesh file (named edges left/bottom/right/top) or skfem MeshTri; else ``divisions``
     of the structured mesh; else chosen for ``accuracy``. cache_dir: default
     $TAILBEAM_CACHE_DIR or ~/.cache/tailbeam; use_cache=False neither reads nor writes.
-    blas_threads: BLAS thread limit during the solve (see _blas_threads).
+    blas_threads: BLAS thread limit during the solve (``tailbeam.plate.blas.blas_threads``).
     """
     fmax_hz, count = _check_request(plate, theory, fmax_hz, count)
     boundary = parse_boundary(boundary)
@@ -343,7 +332,7 @@ def _solve_fresh(plate, boundary, res, mesh, mesh_obj, request, blas_threads):
     free-DOF mode shapes, info). request = (fmax_hz, count, accuracy, mindlin_degree)."""
     fmax_hz, count, accuracy, mindlin_degree = request
     cost = _solve_cost(plate, boundary, res, mesh_obj, fmax_hz, count, mindlin_degree)
-    threads = _blas_threads(blas_threads)
+    threads = blas_threads_limit(blas_threads)
     with threadpool_limits(limits=threads):
         t0 = time.perf_counter()
         model = assemble_plate(
