@@ -7,7 +7,9 @@ from 0.02-0.15 m above a 0.4 x 0.5 m area of the upper half of a rigid 20-degree
 (1.2 x 0.6 m, x downhill), friction
 mu_s = mu_d = 0.7, rolling resistance mu_r = 0.5 (tan 20 deg = 0.36: a lump that stops stays),
 v_s = 1e-3 m/s, v_d = 2e-3 m/s, damping 300 N s/m; the stream lasts n / 100 s and the
-simulation 1 s longer (500 lumps: 5 s of stream, 6 s simulated).
+simulation 1 s longer (500 lumps: 5 s of stream, 6 s simulated). The plate loads are not
+kept (``solve_stream(loads=False)``, as ``tailbeam simulate`` runs a rigid plate's scene);
+each row gives the process's peak resident memory.
 
 Rows, each case in its own process (timed inside it, after a warm-up that fills the numba
 cache): wall and CPU time (the process's: the machine may be shared), kernel steps,
@@ -25,6 +27,7 @@ load (``os.getloadavg``) before and after: the machine may be shared.
 import argparse
 import json
 import os
+import resource
 import sys
 import time
 from pathlib import Path
@@ -79,7 +82,7 @@ def run_case(n: int, sleep: bool, extra: float = 1.0, islands: bool = True) -> d
     t0, c0 = time.perf_counter(), time.process_time()
     run = solve_stream(scene.particles, scene.incline, scene.duration,
                        contacts=scene.contacts(), friction=scene.friction, sleep=sleep,
-                       progress=False, max_work=10**9)  # fmt: skip
+                       progress=False, max_work=10**9, loads=False)  # fmt: skip
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     s = run.stats
     books = s["energy_final"] + s["energy_left"] + s["rest_energy_removed"] + s["energy_friction"]
@@ -96,6 +99,7 @@ def run_case(n: int, sleep: bool, extra: float = 1.0, islands: bool = True) -> d
         "slow_fraction": _slow(run) / on_plate if on_plate else 0.0,
         "energy_released": s["energy_released"], "energy_booked": books,
         "energy_residual": books - s["energy_released"], "late_starts": int(s["late_starts"]),
+        "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3,
         "final": {k: [list(map(float, x)), list(map(float, v))] for k, (x, v) in run.final.items()},
     }  # fmt: skip
 
@@ -142,7 +146,8 @@ def main(argv=None) -> int:
     for n in counts:
         row = _in_child(n, True, 1.0, not args.one_set)
         rows.append(row)
-        print(f"{n} lumps: {row['wall_s']:.1f} s, {row['cpu_s']:.1f} s CPU, asleep "
+        print(f"{n} lumps: {row['wall_s']:.1f} s, {row['cpu_s']:.1f} s CPU, "
+              f"{row['peak_rss_MB']:.0f} MB peak, asleep "
               f"{row['at_rest_fraction']:.2f}, energy residual {row['energy_residual']:.3g} J",
               file=sys.stderr)  # fmt: skip
         partial = [{k: v for k, v in r.items() if k != "final"} for r in rows]

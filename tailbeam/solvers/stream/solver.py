@@ -171,7 +171,7 @@ def simulate_stream(particles, incline: InclinedPlate, duration: float, *, laws,
         particles, incline, duration, rtol=rtol, rest_speed=rest_speed, max_work=max_steps,
         progress=progress, plate=_stream_plate(setup),
         contacts=contact_table(particles, laws, incline.plate.material), frames=frames,
-        friction=friction,
+        friction=friction, loads=setup is not None,  # (only a modal plate replays them)
     )  # fmt: skip
     number_contacts(run.contacts, run.leaves, incline)
     flow = _delivered(streams, particles, run, duration)

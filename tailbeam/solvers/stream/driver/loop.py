@@ -133,6 +133,7 @@ def solve_stream(
     frames=(),
     friction=None,
     sleep=True,
+    loads=True,
 ) -> StreamRun:
     """Simulate a stream of particles on an inclined plate.
 
@@ -175,6 +176,10 @@ def solve_stream(
         With friction on the rigid plate: freeze resting clusters
         (``tailbeam.solvers.stream.driver.sleep``); False integrates them for as long as
         they rest.
+    loads : bool
+        Keep the plate loads (``StreamRun.loads`` and ``dead_loads``) for a replay on a
+        modal plate; False keeps none (both empty; every other output the same). Kept, their
+        force nodes are bounded (``driver.loads.MAX_LOAD_NODES``, WorkLimitError beyond).
 
     Returns
     -------
@@ -194,7 +199,7 @@ def solve_stream(
         if plate is not None:
             plate.reset()
         sim = _Stream(particles, incline, duration, contacts, rtol, rest_speed, max_work, plate,
-                      friction, frames, sleep)  # fmt: skip
+                      friction, frames, sleep, loads)  # fmt: skip
         try:
             run = _run(sim, duration, progress)
         except _Stuck as err:
@@ -263,10 +268,12 @@ class _Stream:
         Frame times (s) at which every ball's state is recorded (``FrameRecorder``).
     sleep : bool
         With friction: freeze resting clusters (``Sleepers``).
+    loads : bool
+        Keep the plate loads (``PlateLoads``).
     """
 
     def __init__(self, particles, incline, duration, contacts, rtol, rest_speed, max_events, plate,
-                 friction=None, frames=(), sleep=True):  # fmt: skip
+                 friction=None, frames=(), sleep=True, loads=True):  # fmt: skip
         self.clock = clock = Clock(duration)
         self.balls = balls = Balls(particles, incline, contacts)
         self.plate, self.max_events, self.rounds = plate, max_events, 0
@@ -288,7 +295,7 @@ class _Stream:
                                            lambda: balls.resting(clock.t), pairs)  # fmt: skip
         self.ledger = EnergyLedger(balls, act, clock.stats)
         self.records = ContactRecords(balls, act, clock, rest_speed)
-        self.loads = PlateLoads(balls, act.forces)
+        self.loads = PlateLoads(balls, act.forces, loads)
         self.heap = Predictions(balls, clock, plate)
         parts = (balls, act, clock, self.heap)
         sleepers = None
@@ -346,6 +353,7 @@ class _Stream:
         if self.rounds % WORK_CHECK_EVERY:
             return
         stats = self.clock.stats
+        self.loads.check(self.clock.t)
         n = stats["heap_events"] + stats["set_events"] + self.act.steps()
         if n > self.max_events:
             raise WorkLimitError(
