@@ -13,7 +13,8 @@ each following one protocol (``tailbeam.solvers.base.Solver``):
   every pair watched, at most ``REFERENCE_MAX_PARTICLES`` bodies), on the rigid plate;
 - ``"auto"`` (the default): ``"single-ball"`` where it can run, else ``"stream"``; a scene
   with friction (``[contact.friction]``): ``"stream"`` (rigid or modal plate; on the rigid
-  plate ``"stream-reference"`` models it too).
+  plate ``"stream-reference"`` models it too), or with Coulomb's law (stiction_velocity = 0)
+  ``"stream-reference"`` (rigid plate).
 
 Running one scene through two solvers is how a user checks one against the other.
 """
@@ -103,7 +104,7 @@ def choose_solver(scene, solver: str = "auto", field: str = "solver") -> Solver:
 def _friction_solver(scene, field: str) -> Solver:
     """The solver "auto" picks for a scene with friction: the fast stream solver, or an
     InputError naming ``contact.friction`` when it cannot run the scene (the modal plate)."""
-    method = SOLVERS["stream"]
+    method = SOLVERS["stream-reference" if scene.friction.coulomb else "stream"]
     why = method.refusal(scene)
     if why:
         raise InputError(

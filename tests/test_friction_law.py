@@ -80,8 +80,12 @@ def test_settings_take_the_adams_defaults_and_name_the_bad_key():
         (dict(static=0.5, dynamic=-0.1), "contact.friction.dynamic"),
         (dict(static=0.3, dynamic=0.4), "contact.friction.dynamic"),
         (
-            dict(static=0.5, dynamic=0.4, stiction_velocity=0.0),
+            dict(static=0.5, dynamic=0.4, stiction_velocity=-1e-3),
             "contact.friction.stiction_velocity",
+        ),
+        (  # 0: Coulomb's law, whose transition velocity is 0 too
+            dict(static=0.5, dynamic=0.4, stiction_velocity=0.0),
+            "contact.friction.transition_velocity",
         ),
         (
             dict(static=0.5, dynamic=0.4, stiction_velocity=1e-3, transition_velocity=1e-3),

@@ -13,21 +13,24 @@ mu is continuous with a continuous derivative (STEP has zero slope at both ends)
 mu(v) ~ 3 mu_s (v / v_s)^2 near v = 0, so F_t is continuously differentiable in v_slip.
 Coulomb's law is the limit v_s, v_d -> 0. The regularisation has a price: a tangential
 load below mu_s |F_n| is held by a slip speed below v_s, not by zero slip (a "creep"
-bounded by v_s).
+bounded by v_s). With v_s = v_d = 0 (``FrictionSettings.coulomb``) the law is Coulomb's:
+mu = mu_d at any slip; a stuck contact's force is whatever holds it, up to mu_s |F_n|, and
+the solver that models it switches stick and slip as events.
 
 Rolling resistance (the constant directional torque of DEM codes): a torque of magnitude
 mu_r R |F_n| against the relative rolling angular velocity omega_roll (the part of the
 relative angular velocity in the contact plane), R the rolling radius (the ball's radius on
 the plate, R1 R2 / (R1 + R2) between two balls). The direction is regularised as the
 friction's is: magnitude mu_r R |F_n| STEP(R |omega_roll|, 0, 0, v_s, 1), so a ball held by
-it creeps at a rolling speed below v_s (``rolling_torque``).
+it creeps at a rolling speed below v_s (``rolling_torque``; with v_s = 0: mu_r R |F_n| at
+any rolling speed, and a held contact's torque is whatever holds it, up to mu_r R |F_n|).
 """
 
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from tailbeam.errors import InputError, require_nonnegative, require_positive
+from tailbeam.errors import InputError, require_nonnegative
 from tailbeam.physics.contact_law import step  # Adams' STEP, the IMPACT law's own
 
 # Adams CONTACT defaults (100 mm/s and 1000 mm/s): coarse; the manual says how far to trust them
@@ -55,18 +58,30 @@ class FrictionSettings:
         for key in ("static", "dynamic", "rolling"):
             object.__setattr__(self, key, require_nonnegative(f"{f}.{key}", getattr(self, key)))
         for key in ("stiction_velocity", "transition_velocity"):
-            object.__setattr__(self, key, require_positive(f"{f}.{key}", getattr(self, key)))
+            object.__setattr__(self, key, require_nonnegative(f"{f}.{key}", getattr(self, key)))
         if self.dynamic > self.static:
             raise InputError(
                 f"{f}.dynamic", f"must be <= static = {self.static!r} (Adams' rule), "
                 f"got {self.dynamic!r}"
             )  # fmt: skip
-        if self.transition_velocity <= self.stiction_velocity:
+        if self.coulomb and self.transition_velocity != 0.0:
+            raise InputError(
+                f"{f}.transition_velocity",
+                "must be 0 with stiction_velocity = 0 (Coulomb's law: mu_s holds a stuck "
+                f"contact, mu_d acts on any slip), got {self.transition_velocity!r}",
+            )
+        if not self.coulomb and self.transition_velocity <= self.stiction_velocity:
             raise InputError(
                 f"{f}.transition_velocity",
                 f"must be > stiction_velocity = {self.stiction_velocity!r} m/s, "
                 f"got {self.transition_velocity!r}",
             )
+
+    @property
+    def coulomb(self) -> bool:
+        """Coulomb's law (v_s = v_d = 0): stick and slip, rolling held and free, switched as
+        events (the ``stream-reference`` solver), in place of the regularised law."""
+        return self.stiction_velocity == 0.0
 
     def values(self) -> dict:
         """The five scene-file keys and their values."""
@@ -77,9 +92,12 @@ def coefficient(speed, static, dynamic, v_s, v_d):
     """mu(v) of the module docstring at slip speeds ``speed`` (m/s, >= 0); the parameters
     may be arrays broadcasting with ``speed``."""
     speed = np.asarray(speed, dtype=float)
+    coulomb = np.asarray(v_s) == 0.0
+    v_s, v_d = np.where(coulomb, 1.0, v_s), np.where(coulomb, 2.0, v_d)  # (unused there)
     rise = step(speed, 0.0, 0.0, v_s, static)
     fall = step(speed, v_s, static, v_d, dynamic)
-    return np.where(speed < v_s, rise, fall)
+    regularised = np.where(speed < v_s, rise, fall)
+    return np.where(coulomb, np.where(speed > 0.0, dynamic, 0.0), regularised)
 
 
 def tangential_force(slip, normal_force, static, dynamic, v_s, v_d):
@@ -101,7 +119,9 @@ def rolling_torque(omega_roll, normal_force, rolling, radius, v_s):
     (rad/s); zero where w = 0. ``radius``: the rolling radius R (m)."""
     omega_roll = np.asarray(omega_roll, dtype=float)
     rate = np.sqrt(np.einsum("...k,...k->...", omega_roll, omega_roll))
-    size = rolling * radius * np.abs(normal_force) * step(radius * rate, 0.0, 0.0, v_s, 1.0)
+    coulomb = np.asarray(v_s) == 0.0
+    ramp = step(radius * rate, 0.0, 0.0, np.where(coulomb, 1.0, v_s), 1.0)
+    size = rolling * radius * np.abs(normal_force) * np.where(coulomb, 1.0, ramp)
     scale = np.divide(size, rate, out=np.zeros_like(rate), where=rate > 0)
     return -scale[..., None] * omega_roll
 
@@ -139,6 +159,11 @@ class FrictionModel:
         default's (InputError naming ``contact.friction.pairs[index].KEY``)."""
         field = f"contact.friction.pairs[{index}]"
         return tuple(materials), replace(self.default, field=field, **values)
+
+    @property
+    def coulomb(self) -> bool:
+        """Whether any pair has Coulomb's law (``FrictionSettings.coulomb``)."""
+        return self.default.coulomb or any(s.coulomb for _names, s in self.pairs)
 
     def values(self) -> dict:
         """The scene-file table: the five keys, then ``pairs`` if any."""

@@ -28,6 +28,10 @@ class EventKind(str, Enum):
     LEAVE = "leave"  # a ball's centre passed an edge of the plate
     RELEASE = "release"  # a ball entered the scene (a stream particle's release time)
     REST = "rest"  # a ball came to rest on the plate (rigid and coupled solvers' rest rules)
+    STICK = "stick"  # Coulomb's law: a contact's slip stopped and is held
+    SLIP = "slip"  # Coulomb's law: a stuck contact broke loose (its force reached mu_s F_n)
+    ROLL_HOLD = "roll_hold"  # Coulomb's law: a contact's rolling stopped and is held
+    ROLL_FREE = "roll_free"  # Coulomb's law: held rolling broke loose (mu_r R F_n reached)
 
     def __str__(self) -> str:
         return self.value
@@ -54,6 +58,10 @@ class EventCode(IntEnum):
     LEAVE = 5
     RELEASE = 6
     REST = 7
+    STICK = 8
+    SLIP = 9
+    ROLL_HOLD = 10
+    ROLL_FREE = 11
 
     @property
     def kind(self) -> EventKind:

@@ -55,6 +55,15 @@ class Stream(Solver):
         x 4."""
         return 4e4 * n_particles + 5e7, 2e-2 * n_particles
 
+    def refusal(self, scene) -> str | None:
+        if scene.friction is not None and scene.friction.coulomb:
+            return (
+                "contact.friction: stiction_velocity = 0 (Coulomb's law, stick and slip as "
+                "events) is modelled by the 'stream-reference' solver only (rigid plate); the "
+                "fast stream solver needs stiction_velocity > 0"
+            )
+        return None
+
     def check(self, scene, options: Options) -> None:
         check_streams(scene, self.max_particles, self.label)
         max_steps = _setting(options.max_steps, self.max_steps)
@@ -102,6 +111,11 @@ class StreamReference(Stream):
     def refusal(self, scene) -> str | None:
         if scene.plate_model == "rigid":
             return None
+        if scene.friction is not None and scene.friction.coulomb:
+            return (
+                "contact.friction: stiction_velocity = 0 (Coulomb's law) runs on the rigid "
+                "plate only (plate.model = \"rigid\", the 'stream-reference' solver)"
+            )
         return (
             "'stream-reference' runs on the rigid plate (plate.model = \"rigid\"), with or "
             "without friction; its modal "

@@ -9,6 +9,7 @@ from tailbeam.physics.contact_law import clamp_indicator
 from tailbeam.physics.hertz import hertz_max_penetration
 from tailbeam.physics.incline import EDGES
 from tailbeam.results.records import End, EventKind
+from tailbeam.solvers.stream.reference.events import COULOMB, FORCE_BAND
 from tailbeam.solvers.stream.reference.friction import slip_speed
 
 
@@ -45,6 +46,7 @@ class SceneChanges:
         self.rtol = rtol
         self.waiting = list(waiting)
         self.radius = np.array([b.radius for b in balls], dtype=float)
+        self.coulomb = None  # a CoulombState where a pair has Coulomb's law (set by the solver)
 
     def slip(self, pair, y) -> float:
         """The slip speed (m/s) of ``pair`` at state vector y (nan without friction)."""
@@ -71,9 +73,13 @@ class SceneChanges:
         kin, li, lj, _ = self.kinematics.of([p], x, v, self.layout.modes(y))
         if kind == EventKind.CONTACT_START:
             self.log.open(p, t, kin, x[li[0]], v, li[0], lj[0])
+            self.start_modes(p, y)
             return y, first_contact_step(p, self.mass, self.rtol, kin.rate[0])
         if kind == EventKind.CONTACT_END:
             self.log.close(p, t, kin, v, li[0], lj[0], End.SEPARATED, self.slip(p, y))
+            return y, None
+        if kind in COULOMB:
+            self.switch(kind, p, t, y)
             return y, None
         if kind == EventKind.FULL_DAMPING:
             p.ramp = not p.ramp
@@ -82,6 +88,49 @@ class SceneChanges:
             kind = EventKind.CLAMP_ON if p.clamped else EventKind.CLAMP_OFF
         self.log.log(t, kind, p)
         return y, None
+
+    def _friction_of(self, p, y):
+        """(normal force N, ``PairFriction`` row, rolling radius m) of pair ``p`` in contact
+        at state vector y, with Coulomb's law's constraint forces (``CoulombState``)."""
+        x, v = self.layout.split(y)
+        pairs, f, fr, table = self.coulomb.at(x, v, self.layout.spins(y))
+        q = next(k for k, other in enumerate(pairs) if other is p)
+        one = type(fr)(*(getattr(fr, name)[q] for name in fr.__dataclass_fields__))
+        return abs(f[q]), one, table.roll_radius[q]
+
+    def start_modes(self, p, y) -> None:
+        """Coulomb's law: a contact starts stuck if its slip is exactly zero (else sliding
+        along it), its rolling held if its rolling velocity is exactly zero (with mu_r > 0)."""
+        if not p.coulomb:
+            return
+        _fn, fr, radius = self._friction_of(p, y)
+        speed, rate = np.linalg.norm(fr.slip), radius * np.linalg.norm(fr.roll)
+        p.stuck = bool(speed == 0.0 and p.friction.static > 0.0)
+        p.slide_dir = fr.slip / speed if speed > 0.0 else np.zeros(3)
+        p.held = bool(rate == 0.0 and p.friction.rolling > 0.0)
+        p.roll_dir = radius * fr.roll / rate if rate > 0.0 else np.zeros(3)
+
+    def switch(self, kind, p, t, y) -> None:
+        """Apply Coulomb's law's event ``kind`` of pair ``p`` at time t (s), state y: a stuck
+        contact (held rolling) breaks loose opposite to the force (torque) that held it; a
+        sliding (rolling) one sticks (is held) if the force (torque) that keeps it so is
+        within mu_s |F_n| (mu_r R |F_n|), else it slides (rolls) on, opposite to it."""
+        sliding = kind in (EventKind.STICK, EventKind.SLIP)
+        if kind in (EventKind.STICK, EventKind.ROLL_HOLD):
+            setattr(p, "stuck" if sliding else "held", True)
+        fn, fr, radius = self._friction_of(p, y)
+        load = fr.force if sliding else fr.rolling
+        size = float(np.linalg.norm(load))
+        limit = (p.friction.static if sliding else p.friction.rolling * radius) * fn
+        holds = kind in (EventKind.STICK, EventKind.ROLL_HOLD) and size <= limit + FORCE_BAND
+        if not holds:
+            direction = -load / size if size > 0.0 else np.zeros(3)
+            if sliding:
+                p.stuck, p.slide_dir = False, direction
+            else:
+                p.held, p.roll_dir = False, direction
+        if holds or kind in (EventKind.SLIP, EventKind.ROLL_FREE):
+            self.log.log(t, kind, p)
 
     def leave(self, ball, edge, t, y):
         """Ball ``ball`` (index) leaves over ``edge`` at time t (s): its contacts end, it and
@@ -126,6 +175,9 @@ class SceneChanges:
                 p.ramp = bool(kin.penetration[0] < p.law.penetration) or not p.kinked
                 ind = clamp_indicator(kin.penetration[0], kin.rate[0], p.law, p.ramp)
                 p.clamped = bool(p.law.clamp and p.kinked and ind < 0.0)
+        for p in pairs:
+            if p.in_contact:
+                self.start_modes(p, y)
 
 
 def first_contact_step(pair, mass, rtol, rate):

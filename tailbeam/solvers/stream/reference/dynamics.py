@@ -8,6 +8,7 @@ import numpy as np
 from tailbeam.physics.contact_law import impact_force_in_region
 from tailbeam.solvers.stream.reference.friction import FrictionTable, friction_of
 from tailbeam.solvers.stream.reference.pairs import law_table
+from tailbeam.solvers.stream.reference.sticking import coulomb_friction
 
 
 class Dynamics:
@@ -73,10 +74,12 @@ class Dynamics:
     def _friction_rhs(self, pairs, laws, ramp, clamped, m, ix):
         """The right-hand side with friction on the rigid plate: the state holds the angular
         velocities; every contact adds its tangential force and the torques
-        (``tailbeam.solvers.stream.reference.friction``)."""
+        (``tailbeam.solvers.stream.reference.friction``; with Coulomb's law, the stuck
+        contacts' constraint forces: ``tailbeam.solvers.stream.reference.sticking``)."""
         layout, kinematics, g = self.layout, self.kinematics, self.gravity
         inertia = 0.4 * m * self.radius[layout.active] ** 2
         table = FrictionTable.of(pairs, self.radius) if pairs else None
+        coulomb = any(p.coulomb for p in pairs)
 
         def rhs(t, y):
             x, v = layout.split(y)
@@ -86,7 +89,10 @@ class Dynamics:
             if pairs:
                 kin, li, lj, is_plate = kinematics.of(ix, x, v)
                 f = impact_force_in_region(kin.penetration, kin.rate, laws, ramp, clamped)
-                fr = friction_of(table, ix, kin, x[None], v[None], w[None], f)
+                if coulomb:  # (stuck contacts' forces hold them: a set-wide solve)
+                    fr = coulomb_friction(table, pairs, ix, kin, f, x, v, w, m, inertia, g)
+                else:
+                    fr = friction_of(table, ix, kin, x[None], v[None], w[None], f)
                 force = f[:, None] * kin.normal + fr.force
                 np.add.at(acc, li, force / m[li, None])
                 np.add.at(alpha, li, fr.torque_i / inertia[li, None])

@@ -26,9 +26,16 @@ from tailbeam.solvers.numerics.step_events import (
     chebyshev_coefficients,
     first_downward_crossing,
 )
+from tailbeam.solvers.stream.reference.sticking import SLIP_TINY
 
 CONTACT = frozenset({EventKind.CONTACT_START, EventKind.CONTACT_END})  # one row, two sides
 CLAMP = frozenset({EventKind.CLAMP_ON, EventKind.CLAMP_OFF})
+SLIDING = frozenset({EventKind.STICK, EventKind.SLIP})  # Coulomb's law (``sticking``)
+ROLLING = frozenset({EventKind.ROLL_HOLD, EventKind.ROLL_FREE})
+COULOMB = SLIDING | ROLLING
+SIDES = (CONTACT, CLAMP, SLIDING, ROLLING)  # the kinds a row switches between
+FORCE_BAND = 1e-9  # N (N m for torques): a stuck contact's force past its limit by this
+SPEED_BAND = 1e-13  # m/s: a slip (or R x rolling rate) past zero by this
 
 
 class RowKey(NamedTuple):
@@ -73,6 +80,7 @@ class EventSearch:
         self.incline = incline
         self.plate = plate
         self.states_at = layout.states_at
+        self.coulomb = None  # a CoulombState where a pair has Coulomb's law (set by the solver)
 
     def rows(self) -> list:
         """Watched functions (``Row``) in a fixed order.
@@ -95,14 +103,19 @@ class EventSearch:
             if p.kinked and p.law.clamp:
                 sign = -1.0 if p.clamped else 1.0
                 rows.append(Row(RowKey(EventKind.CLAMP_ON, pk), sign, False, 1e-10))
+            if p.coulomb:
+                rows.extend(_coulomb_rows(pk, p))
         for b in self.layout.active:
             for e in range(len(EDGES)):
                 rows.append(Row(RowKey(EventKind.LEAVE, (b, e)), 1.0, True, 1e-13))
         return rows
 
-    def row_values(self, rows, x, v, modes=None) -> np.ndarray:
+    def row_values(self, rows, x, v, modes=None, w=None) -> np.ndarray:
         """Values of ``rows`` at the states x (m), v (m/s), (K, n, 3) each (and modes, each
-        (K, m)): array (len(rows), K) (m^2 for distances, m for edges)."""
+        (K, m); w the angular velocities (K, n, 3) rad/s, for Coulomb's law's rows): array
+        (len(rows), K) (m^2 for distances, m for edges, N or m/s for Coulomb's law's)."""
+        if any(r.key.kind in COULOMB for r in rows):
+            return self._with_coulomb_rows(rows, x, v, modes, w)
         pair_keys = [r.key.target for r in rows if r.key.kind != EventKind.LEAVE]
         pairs = [self.pairs[k] for k in dict.fromkeys(pair_keys)]
         index = {id(p): q for q, p in enumerate(pairs)}
@@ -132,13 +145,51 @@ class EventSearch:
                 ]
         return out
 
+    def _with_coulomb_rows(self, rows, x, v, modes, w) -> np.ndarray:
+        """``row_values`` where some rows are Coulomb's law's: those from the friction of the
+        pairs in contact at each state (``CoulombState``), the others as usual."""
+        out = np.empty((len(rows), x.shape[0]))
+        plain = [r for r, row in enumerate(rows) if row.key.kind not in COULOMB]
+        if plain:
+            out[plain] = self.row_values([rows[r] for r in plain], x, v, modes)
+        coulomb = [r for r in range(len(rows)) if r not in set(plain)]
+        for k in range(x.shape[0]):
+            pairs, f, fr, table = self.coulomb.at(x[k], v[k], w[k])
+            index = {id(p): q for q, p in enumerate(pairs)}
+            for r in coulomb:
+                kind, key = rows[r].key
+                p = self.pairs[key]
+                out[r, k] = coulomb_value(kind, p, index[id(p)], f, fr, table)
+        return out
+
+    def set_directions(self, y) -> None:
+        """Coulomb's law: each sliding or rolling contact's direction at the start of the
+        step about to be taken (state vector y), which its force opposes past zero and its
+        ``STICK`` or ``ROLL_HOLD`` row watches the slip or rolling velocity cross
+        (``Pair.slide_dir`` / ``roll_dir`` while it is ~zero)."""
+        if self.coulomb is None or not self.coulomb.any():
+            return
+        x, v = self.layout.split(y)
+        pairs, _f, fr, table = self.coulomb.at(x, v, self.layout.spins(y))
+        for q, p in enumerate(pairs):
+            if not p.coulomb:
+                continue
+            slip, roll = fr.slip[q], fr.roll[q] * table.roll_radius[q]
+            speed, rate = np.linalg.norm(slip), np.linalg.norm(roll)
+            p.slide_ref = slip / speed if speed >= SLIP_TINY else p.slide_dir
+            p.roll_ref = roll / rate if rate >= SLIP_TINY else p.roll_dir
+
     def detect(self, dense, t0, t1, fresh):
         """Earliest event on the step [t0, t1] (s) with dense output ``dense``: (row, time)
         or None. ``fresh``: keys of the events applied at t0."""
         rows = self.rows()
         if not rows or t1 <= t0:
             return None
-        values = self.row_values(rows, *self.states_at(dense, t0 + STEP_POINTS * (t1 - t0)))
+        times = t0 + STEP_POINTS * (t1 - t0)
+        spins = None
+        if self.coulomb is not None and self.coulomb.any():
+            spins = self.layout.spins_at(dense, times)
+        values = self.row_values(rows, *self.states_at(dense, times), spins)
         # g = sign x value + band: positive on the row's side, its event where g < 0
         g = (
             np.array([r.sign for r in rows])[:, None] * values
@@ -174,8 +225,10 @@ class EventSearch:
         k = int(change[0]) + 1
 
         def f(s):
-            states = self.states_at(dense, np.array([t0 + s * (t1 - t0)]))
-            return row.sign * self.row_values([row], *states)[0, 0] + row.band
+            at = np.array([t0 + s * (t1 - t0)])
+            states = self.states_at(dense, at)
+            spins = self.layout.spins_at(dense, at)
+            return row.sign * self.row_values([row], *states, spins)[0, 0] + row.band
 
         return brentq(f, STEP_POINTS[k - 1], STEP_POINTS[k], xtol=1e-15, rtol=1e-15)
 
@@ -184,7 +237,9 @@ class EventSearch:
         i.e. its event may be applied there."""
         x, v = self.layout.split(y)
         modes = self.layout.modes(y[None])
-        return bool(row.sign * self.row_values([row], x[None], v[None], modes)[0, 0] <= row.band)
+        w = self.layout.spins(y[None])
+        value = self.row_values([row], x[None], v[None], modes, w)[0, 0]
+        return bool(row.sign * value <= row.band)
 
     def too_far(self, dense, t0, t1) -> bool:
         """Modal plate: whether a ball moved more than 1 / k_max sideways on the step [t0, t1]
@@ -205,8 +260,35 @@ def _same_switch(key, fresh) -> bool:
     for f_kind, f_k in fresh:
         if f_k != k:
             continue
-        if f_kind == kind or (kind in CONTACT and f_kind in CONTACT):
-            return True
-        if kind in CLAMP and f_kind in CLAMP:
+        if f_kind == kind or any(kind in side and f_kind in side for side in SIDES):
             return True
     return False
+
+
+def _coulomb_rows(pk, p) -> list:
+    """Coulomb's law's rows of pair ``p`` (key ``pk``) in contact: while stuck its force
+    against mu_s |F_n| (``SLIP``), while sliding its slip along the step's start direction
+    (``STICK``); the same for its rolling with mu_r > 0 (``ROLL_FREE``, ``ROLL_HOLD``)."""
+    rows = []
+    if p.friction.static > 0.0:
+        kind = EventKind.SLIP if p.stuck else EventKind.STICK
+        rows.append(Row(RowKey(kind, pk), 1.0, False, FORCE_BAND if p.stuck else SPEED_BAND))
+    if p.friction.rolling > 0.0:
+        kind = EventKind.ROLL_FREE if p.held else EventKind.ROLL_HOLD
+        rows.append(Row(RowKey(kind, pk), 1.0, False, FORCE_BAND if p.held else SPEED_BAND))
+    return rows
+
+
+def coulomb_value(kind, p, q, normal, fr, table) -> float:
+    """The value of pair ``p``'s Coulomb row of ``kind`` (its index q among the pairs in
+    contact, their normal forces ``normal`` N, ``PairFriction`` ``fr`` and
+    ``FrictionTable`` ``table``): the margin to the limit (N; N m for rolling) while stuck
+    or held, else the slip (R x rolling velocity, m/s) along the step's start direction."""
+    fn, radius = abs(normal[q]), table.roll_radius[q]
+    if kind == EventKind.SLIP:
+        return p.friction.static * fn - float(np.linalg.norm(fr.force[q]))
+    if kind == EventKind.STICK:
+        return float(fr.slip[q] @ p.slide_ref)
+    if kind == EventKind.ROLL_FREE:
+        return p.friction.rolling * radius * fn - float(np.linalg.norm(fr.rolling[q]))
+    return float(radius * fr.roll[q] @ p.roll_ref)

@@ -61,6 +61,7 @@ class PairFriction:
     slip: np.ndarray
     roll: np.ndarray
     power: np.ndarray
+    rolling: np.ndarray | None = None  # the rolling-resistance torque on ball i (Coulomb's law)
 
 
 def pair_friction(table, kin, normal_force, xi, vi, wi, xj, vj, wj) -> PairFriction:

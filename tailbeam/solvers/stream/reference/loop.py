@@ -134,6 +134,7 @@ class StepLoop:
         (or the event applied at once if it lies at the step's start)."""
         solver = self.solver
         t0, y0 = solver.t, solver.y.copy()
+        self.search.set_directions(y0)  # (Coulomb's law: the step's sliding directions)
         self.integrator.step(solver)
         self.steps += 1
         if self.steps > self.max_steps:

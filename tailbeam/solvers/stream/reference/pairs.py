@@ -43,6 +43,15 @@ class Pair:
         The open contact's integral of the normal force (N s).
     tangential_impulse : ndarray
         The open contact's integral of the tangential force on ball i (3,) (N s).
+    stuck, held : bool
+        Coulomb's law (``FrictionSettings.coulomb``): the slip is stuck at zero, the rolling
+        held at zero (``tailbeam.solvers.stream.reference.sticking``).
+    slide_dir, roll_dir : ndarray
+        Coulomb's law: the direction (3,) a contact slides or rolls in while its slip or
+        rolling speed is still zero (it broke loose along it).
+    slide_ref, roll_ref : ndarray
+        Coulomb's law: the sliding and rolling directions at the current step's start,
+        which the events watch the slip and rolling velocity cross.
     """
 
     i: int
@@ -62,6 +71,17 @@ class Pair:
     share: float = 1.0
     normal_impulse: float = 0.0
     tangential_impulse: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    stuck: bool = False
+    held: bool = False
+    slide_dir: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    roll_dir: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    slide_ref: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    roll_ref: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    @property
+    def coulomb(self) -> bool:
+        """Whether the pair has Coulomb's law (stick and slip as events)."""
+        return self.friction is not None and self.friction.coulomb
 
     @property
     def kinked(self) -> bool:
@@ -76,6 +96,7 @@ class Pair:
         self.peak, self.t_peak, self.pen = 0.0, math.nan, max(0.0, penetration)
         self.records, self.phi0, self.grad0 = records, phi0, grad0
         self.normal_impulse, self.tangential_impulse = 0.0, np.zeros(3)
+        self.stuck = self.held = False
 
     def stop(self, slip=math.nan) -> None:
         """Close the contact: its peaks go into its records, which it then lets go. ``slip``:
@@ -86,10 +107,13 @@ class Pair:
     def write_peaks(self, slip=math.nan) -> None:
         """Copy the peak force, its time, the largest penetration and the impulses into the
         records; with friction, how the contact ended tangentially: ``sticking`` if the slip
-        speed ``slip`` (m/s) is below the stiction velocity, else ``sliding``."""
+        speed ``slip`` (m/s) is below the stiction velocity (Coulomb's law: if it is stuck),
+        else ``sliding``."""
         tangential = float(np.linalg.norm(self.tangential_impulse))
         end = "frictionless"
-        if self.friction is not None:
+        if self.coulomb:
+            end = "sticking" if self.stuck else "sliding"
+        elif self.friction is not None:
             end = "sticking" if slip < self.friction.stiction_velocity else "sliding"
         for rec in self.records:
             rec.peak_force, rec.t_peak, rec.max_penetration = self.peak, self.t_peak, self.pen

@@ -73,12 +73,14 @@ from tailbeam.solvers.stream.reference.changes import SceneChanges
 from tailbeam.solvers.stream.reference.contacts import ContactLog
 from tailbeam.solvers.stream.reference.dynamics import Dynamics
 from tailbeam.solvers.stream.reference.events import EventSearch
+from tailbeam.solvers.stream.reference.friction import FrictionTable
 from tailbeam.solvers.stream.reference.kinematics import Kinematics
 from tailbeam.solvers.stream.reference.loop import Integrator, StepLoop
 from tailbeam.solvers.stream.reference.pairs import PairSet
 from tailbeam.solvers.stream.reference.plate import ReferencePlate
 from tailbeam.solvers.stream.reference.state import StateLayout
 from tailbeam.solvers.stream.reference.steps import StepSeries
+from tailbeam.solvers.stream.reference.sticking import CoulombState
 
 MODAL_STEPS_PER_PERIOD = 5  # a lower bound of the steps per period of the top mode
 
@@ -213,6 +215,11 @@ def simulate_stream_reference(
         _check_modal_work(plate, duration, max_steps)
     if friction is not None and not isinstance(friction, FrictionModel):
         raise InputError("contact.friction", "must be a FrictionModel (or None: frictionless)")
+    if friction is not None and friction.coulomb and plate is not None:
+        raise InputError(
+            "contact.friction.stiction_velocity",
+            "0 (Coulomb's law) runs on the rigid plate only (no modal plate)",
+        )
     _check_balls(balls, incline)
     table = contact_table(balls, options, incline.plate.material)  # the pairs' laws
     run = (balls, incline, table, release, plate, duration, rtol, max_steps, progress)
@@ -239,6 +246,10 @@ def _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, 
     dynamics = Dynamics(layout, kinematics, pairs, mass, incline.gravity_vector, plate, radius)
     integrator = Integrator(dynamics, layout, plate, rtol, radius)
     loop = StepLoop(integrator, search, changes, series, max_steps, progress)
+    if friction is not None and friction.coulomb:
+        coulomb = CoulombState(layout, kinematics, pairs, mass, radius, incline.gravity_vector,
+                               FrictionTable.of)  # fmt: skip
+        changes.coulomb = series.coulomb = search.coulomb = coulomb
     y = _initial_state(balls, present, plate, layout.spin)
     changes.touch(list(pairs.values()), 0.0, y)
     loop.run(0.0, y, duration)

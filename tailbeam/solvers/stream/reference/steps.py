@@ -19,6 +19,7 @@ from tailbeam.solvers.numerics.step_events import (
 )
 from tailbeam.solvers.stream.reference.friction import (
     FrictionTable,
+    PairFriction,
     friction_of,
     kinematics_with_surface,
 )
@@ -34,6 +35,7 @@ def _weights() -> np.ndarray:
 
 
 STEP_WEIGHTS = _weights()
+FIELDS = ("force", "torque_i", "torque_j", "slip", "roll", "power")  # PairFriction's
 
 
 class StepSeries:
@@ -73,6 +75,7 @@ class StepSeries:
         self.plate = plate
         self.times, self.energy, self.states, self.plate_states = [], [], [], []
         self.spins, self.dissipated, self.friction_work = [], [], 0.0
+        self.coulomb = None  # a CoulombState where a pair has Coulomb's law (set by the solver)
 
     def update_peaks(self, dense, t0, t1) -> None:
         """Update the peak force, largest penetration and impulses of the contacts (and with
@@ -105,16 +108,25 @@ class StepSeries:
         dissipated on it: ``force`` (P, K) normal forces (N) at the step's points, ``states``
         and ``w`` the states there, h the step (s)."""
         x, v, modes = states
-        ix = self.kinematics.index(pairs)
-        kin, _, _, _, surface = kinematics_with_surface(self.kinematics, ix, x, v, modes)
-        table = FrictionTable.of(pairs, self.radius)
-        fr = friction_of(table, ix, kin, x, v, w, force.T.ravel(), surface)
+        if self.coulomb is not None and any(p.coulomb for p in pairs):
+            fr = self._coulomb_friction(x, v, w)
+        else:
+            ix = self.kinematics.index(pairs)
+            kin, _, _, _, surface = kinematics_with_surface(self.kinematics, ix, x, v, modes)
+            table = FrictionTable.of(pairs, self.radius)
+            fr = friction_of(table, ix, kin, x, v, w, force.T.ravel(), surface)
         k = len(STEP_POINTS)
         tangential = fr.force.reshape(k, len(pairs), 3)
         impulse = np.einsum("k,kpc->pc", STEP_WEIGHTS, tangential) * h
         for q, p in enumerate(pairs):
             p.tangential_impulse = p.tangential_impulse + impulse[q]
         self.friction_work += float(STEP_WEIGHTS @ fr.power.reshape(k, len(pairs)).sum(axis=1)) * h
+
+    def _coulomb_friction(self, x, v, w) -> PairFriction:
+        """The friction of the pairs in contact at the states x, v, w (K, n, 3), with
+        Coulomb's law's constraint forces (``CoulombState``), flattened state-major."""
+        parts = [self.coulomb.at(x[k], v[k], w[k])[2] for k in range(x.shape[0])]
+        return PairFriction(*(np.concatenate([getattr(p, f) for p in parts]) for f in FIELDS))
 
     def pair_forces(self, pairs, x, v, modes=None):
         """Force (N) and penetration (m) of ``pairs`` at states x, v (K, n, 3) (and modes):
