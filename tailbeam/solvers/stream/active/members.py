@@ -448,8 +448,9 @@ class ActiveMembers:
     def ball_energies(self, balls) -> np.ndarray:
         """Per ball of ``balls`` (members): its kinetic energy (rotation included with
         friction), its plate contact's elastic energy and half of each of its touching
-        ball-ball pairs' (all of a pair with a FIXED obstacle, which takes none) (J): summed over a group holding both balls of each of its pairs,
-        the group's kinetic and elastic energy."""
+        ball-ball pairs' (all of a pair with a FIXED obstacle, which takes none) (J): summed
+        over a group holding both balls of each of its pairs, the group's kinetic and elastic
+        energy."""
         s = self._ready()
         q = np.array([self.local[int(i)] for i in balls], dtype=np.int64)
         m = s.model.mass[q]
@@ -478,7 +479,8 @@ class ActiveMembers:
         s = self._ready()
         total = 0.0
         for key in self.touching_pairs(i):
-            share = 1.0 if key[1] < 0 or key[0] in self.fixed or key[1] in self.fixed else ball_share
+            alone = key[1] < 0 or key[0] in self.fixed or key[1] in self.fixed
+            share = 1.0 if alone else ball_share
             total += share * s.contact_energy(self.index[key])
         return total
 
