@@ -74,9 +74,18 @@ class Membership:
                 self.sleepers.wake(k)
 
     def join(self, ids, key) -> None:
-        """Closed-form balls ``ids`` start the contact ``key`` now (found in closed form)."""
+        """Closed-form balls ``ids`` start the contact ``key`` now (found in closed form); a
+        sleeping one touched slowly stays asleep, a FIXED obstacle (``Sleepers``)."""
+        b = self.balls
+        asleep = [i for i in ids if b.status[i] == SLEEP]
+        if len(asleep) == 1 and len(ids) == 2 and not self.sleepers.wakes_on_touch(key):
+            other = ids[0] if ids[1] == asleep[0] else ids[1]
+            if not b.in_set[other]:
+                self._absorb(other)
+            self.act.add_fixed(asleep[0], owner=other)
+            ids = [other]
         for i in ids:
-            if not self.balls.in_set[i]:
+            if not b.in_set[i]:
                 self._absorb(i)
         self.act.start_contact(key)
         self.start(key)

@@ -31,14 +31,15 @@ active set (at least every ``membership.SET_HORIZON``):
   move, the sleeping ball feels nothing and costs no steps (the ledger books all of such a
   contact's elastic energy with the awake ball; its friction's work as any contact's);
 * a contact that starts between an awake ball and a sleeping one faster than WAKE_SPEED
-  (an impact: a fixed obstacle would reflect what the struck ball should take), or a touch
-  predicted in closed form, wakes the sleeping ball alone: it rejoins the active set at
+  (an impact: a fixed obstacle would reflect what the struck ball should take; found by
+  the set or predicted in closed form) wakes the sleeping ball alone: it rejoins the active set at
   rest with its contacts touching (resumed contact records); the sleeping balls it touches
   stay asleep, FIXED obstacles for it;
-* at every check each group of sleeping balls touched by awake balls (connected through
-  their frozen contacts) must still stand under those balls' contact loads now (the same
-  statics): where it does not, its balls touched by awake balls wake, and what is left of
-  it is checked again under their loads, until what is left stands.
+* at the first check of every SET_HORIZON (1 ms) each group of sleeping balls touched by
+  awake balls (connected through their frozen contacts) must still stand under those
+  balls' contact loads then (the same statics): where it does not, its balls touched by
+  awake balls wake, and what is left of it is checked again under their loads, until what
+  is left stands.
 """
 
 import numpy as np
@@ -94,6 +95,7 @@ class Sleepers:
         self.reach = {}  # core ball -> its speed bound (m/s) at the last check
         self.bonds, self.adj = {}, {}
         self.make_core = None
+        self.next_recheck = 0.0  # s: the loaded sleeping groups' statics checked again then
         self._mus = {}  # contact key -> the mu of the last statics solved
 
     # --- the checks -----------------------------------------------------------------------------
@@ -112,8 +114,10 @@ class Sleepers:
                 self.slow_since.setdefault(i, t)
             else:
                 self.slow_since.pop(i, None)
-        if self._recheck(touching):
+        if t >= self.next_recheck and self._recheck(touching):
             touching = self._touching()
+        if t >= self.next_recheck:
+            self.next_recheck = t + SET_HORIZON
         ready = {i for i in slow if t - self.slow_since.get(i, t) >= SLEEP_DWELL}
         ready = {i for i in ready - set(excluded) if self.balls.status[i] == ACTIVE}
         frozen = []
@@ -389,11 +393,17 @@ class Sleepers:
         """Whether contact ``key``, starting now between an awake ball and a sleeping one,
         wakes the sleeping one: its balls approach faster than WAKE_SPEED."""
         i, j = key
-        xi, vi = self.act.state(i)
-        xj, vj = self.act.state(j)
+        xi, vi = self._state(i)
+        xj, vj = self._state(j)
         d = xi - xj
         rate = -float((vi - vj) @ d) / float(np.sqrt(d @ d))
         return rate > WAKE_SPEED
+
+    def _state(self, i: int):
+        """Position (m) and velocity (m/s) of ball i now (in the set or in closed form)."""
+        if self.balls.in_set[i] or i in self.act.fixed:
+            return self.act.state(i)
+        return self.balls.state(i, self.clock.t)
 
     def wake(self, i: int) -> list:
         """Sleeping ball i wakes alone: it rejoins the active set at rest where it is, its
