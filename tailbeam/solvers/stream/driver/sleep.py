@@ -11,15 +11,16 @@ active set (at least every ``membership.SET_HORIZON``):
   slip plus rolling at each contact; a spin, about a contact normal or not, is not looked
   at and is dropped when the ball is frozen);
 * a GROUP is a connected set of core balls slow for SLEEP_DWELL (READY) through touching
-  ball-ball contacts; while a slow ball outside it touches it, it waits (counted in
-  ``sleep_deferred``: it is frozen with that ball, in one statics, when that one is ready
-  too); it is frozen when the rigid statics (``statics.in_equilibrium``) of
-  the group together with the frozen balls it touches (their whole frozen groups) admit
-  equilibrium within the Coulomb and rolling limits, the contacts of the awake balls that
-  touch them acting as given loads, as they are now (normal force, friction, rolling
-  torque). A contact slipping at its stiction velocity or faster is held to
-  min(mu_s, mu_d), what sliding friction gives. Refused: slow again from now. The statics,
-  not the creep speeds, say whether it can stand;
+  ball-ball contacts; while a slow ball outside it touches it, it waits, at most another
+  SLEEP_DWELL (counted in ``sleep_deferred``: it is frozen with that ball, in one statics,
+  when that one is ready too, rather than under its load of the moment); it is frozen
+  when the rigid statics (``statics.in_equilibrium``) of the group together with the
+  frozen balls it touches (their whole frozen groups) admit equilibrium within the
+  Coulomb and rolling limits, the contacts of the awake balls that touch them acting as
+  given loads, as they are now (normal force, friction, rolling torque). A contact
+  slipping at its stiction velocity or faster is held to min(mu_s, mu_d), what sliding
+  friction gives. Refused: slow again from now. The statics, not the creep speeds, say
+  whether it can stand;
 * frozen, its balls leave the active set and are ASLEEP (``balls.SLEEP``): velocity and
   angular velocity exactly zero, position fixed, their contacts with one another and the
   plate at the penetrations they had (their records end as ``rest``; the kinetic energy
@@ -122,7 +123,8 @@ class Sleepers:
         ready = {i for i in ready - set(excluded) if self.balls.status[i] == ACTIVE}
         frozen = []
         for comp in self._groups(ready, touching):
-            if self._slow_neighbour(comp, touching, slow):
+            waited = t - max(self.slow_since[i] for i in comp) - SLEEP_DWELL
+            if waited < SLEEP_DWELL and self._slow_neighbour(comp, touching, slow):
                 self.clock.count("sleep_deferred")
                 continue
             bodies, keys, loads = self._system(comp, touching)
