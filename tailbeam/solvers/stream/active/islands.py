@@ -20,6 +20,10 @@ put back (``ActiveSet.snapshot``) and advanced again up to it, so each island's 
 its own and events come in time order, as from one set. Two islands' events at the same
 instant are returned one per call.
 
+Sleeping balls an island's members could touch within the horizon are its FIXED obstacles
+(``ActiveMembers.set_fixed``; assigned at each grouping, ``group``): a FIXED ball moves
+neither, so it joins no two islands, and it may be an obstacle of several.
+
 The modal plate couples every contact through its modes: there the driver keeps one set.
 """
 
@@ -241,7 +245,7 @@ class Islands:
             out[ks] = isl.ball_energies([balls[k] for k in ks])
         return out
 
-    def group(self, horizon: float) -> tuple[list, set]:
+    def group(self, horizon: float) -> tuple[list, set, list]:
         """The islands for the next ``horizon`` (s): touching balls together, then groups
         whose balls could come into contact within it (``speed_bounds``) merged until none
         can. Returns the islands (lists of balls, in member order), the pairs (i, j), i < j,

@@ -9,6 +9,10 @@ balls near a contact). A set rebuilt at the instant of an event carries the rows
 were applied then (``carry.CarriedRows``), so that it does not apply the same event again at
 once (``kernel.advance``).
 
+With friction a set may also carry FIXED obstacles (``set_fixed``): sleeping balls held
+where they are, whose pairs with the members act on the members only (the kernel's
+``pairs.FIXED``); two of them never form a pair.
+
 Its parts: the plate force histories (``plate.forces.PlateForces``), putting a member at rest
 (``plate.rest``) and, on the modal plate, the plate pairs' shapes, compliance and tails
 (``plate.pairs.PlatePairs``).
