@@ -13,7 +13,7 @@ each row gives the process's peak resident memory.
 
 Rows, each case in its own process (timed inside it, after a warm-up that fills the numba
 cache): wall and CPU time (the process's: the machine may be shared), kernel steps,
-contacts, clusters frozen and woken, the fraction of the
+contacts, groups frozen and lumps woken, the fraction of the
 lumps still on the plate that are asleep at the end, the energy ledger (released = final +
 left + removed at rest + friction; its residual, which must not be a gain), and the fitted
 exponent of wall and CPU time against the number of lumps; ``--one-set`` integrates the

@@ -10,6 +10,7 @@ import numpy as np
 from tailbeam.physics.incline import EDGES
 from tailbeam.physics.pair import pair_kinematics, plate_foot
 from tailbeam.results.records import PLATE, EventCode, Impact, LeaveEvent
+from tailbeam.solvers.stream.active.compiled.pairs import GONE
 from tailbeam.solvers.stream.active.integrator.set import ActiveSet
 
 
@@ -82,7 +83,7 @@ class SceneRun:
 
     def record(self, t):
         s = self.set
-        m, alive = s.model.mass, s.model.alive
+        m, alive = s.model.mass, s.model.alive != GONE
         e = 0.5 * float(np.sum(m[alive, None] * s.v[alive] ** 2))
         e -= float(np.sum(m[alive] * (s.x[alive] @ s.model.g)))
         for p in np.flatnonzero(s.contacts.touching):

@@ -231,16 +231,15 @@ def test_lump_resting_close_beside_a_frozen_one_leaves_it_asleep():
 
 
 def test_resting_neighbours_are_frozen_without_waking_each_other():
-    """As above 5 µm apart, within the reach of either: a is ready first but would be woken at
-    once by b, so it waits awake until b is ready too, and both are frozen at that check: no
-    wake (freezing one and waking it at once, again and again, is what this avoids). The
-    full integration is the truth that they never touch; both end where it holds them, up to
-    the creep before freezing."""
+    """As above 5 µm apart, within the reach of b: a is frozen first and is a FIXED obstacle
+    of the set while b could reach it; b never touches it, so a is not woken, and b is
+    frozen ~10 ms later. The full integration is the truth that they never touch; both end
+    where it holds them, up to the creep before freezing."""
     balls = beside(5e-6)
     r = run(balls, 0.0, 0.1, rolling=0.2)
     free = run(balls, 0.0, 0.1, rolling=0.2, sleep=False)
     assert r.stats["sleeps"] == 2 and r.stats.get("wakes", 0) == 0
-    assert r.stats["asleep_final"] == 2 and r.stats["sleep_deferred"] >= 1
+    assert r.stats["asleep_final"] == 2 and r.stats["fixed_obstacles"] >= 1
     assert not [k for k in free.contacts if k.partner in "ab" and k.ball in "ab"]
     for n in "ab":
         assert np.linalg.norm(r.final[n][0] - free.final[n][0]) <= CREEP_BOUND

@@ -20,6 +20,10 @@ put back (``ActiveSet.snapshot``) and advanced again up to it, so each island's 
 its own and events come in time order, as from one set. Two islands' events at the same
 instant are returned one per call.
 
+Sleeping balls an island's members could touch within the horizon are its FIXED obstacles
+(``ActiveMembers.set_fixed``; assigned at each grouping, ``group``): a FIXED ball moves
+neither, so it joins no two islands, and it may be an obstacle of several.
+
 The modal plate couples every contact through its modes: there the driver keeps one set.
 """
 
@@ -62,6 +66,7 @@ class Islands:
         self.settle_energy = settle_energy
         self.members, self.islands, self.kinks = [], [], []
         self.of = {}  # ball -> its island
+        self.fixed = set()  # the FIXED obstacles (sleeping balls members may touch)
         self._now = 0.0
         self.forces = self._new().forces
         self.forces.pending = self._flush_of
@@ -104,6 +109,55 @@ class Islands:
         self.members.append(i)
         self.valid_until = -np.inf
 
+    # --- FIXED obstacles ---------------------------------------------------------------------
+    def add_fixed(self, k: int, owner=None) -> None:
+        """Sleeping ball k is a FIXED obstacle of the islands whose members could touch it
+        (assigned at the next grouping, ``group``); ``owner``: a member touching it now,
+        whose island holds it from now on."""
+        if owner is not None:
+            isl = self.of[owner]
+            if k not in isl.fixed:
+                isl.set_fixed(isl.fixed + [k])
+        if k not in self.fixed:
+            self.fixed.add(k)
+            self.valid_until = -np.inf
+
+    def remove_fixed(self, k: int) -> None:
+        """Ball k is no FIXED obstacle any more."""
+        self.fixed.discard(k)
+        for isl in self.islands:
+            if k in isl.fixed:
+                isl.set_fixed([f for f in isl.fixed if f != k])
+
+    def to_fixed(self, i: int) -> None:
+        """Member i, frozen now, stays a FIXED obstacle of its island."""
+        isl = self.of.pop(i)
+        isl.to_fixed(i)
+        self.members.remove(i)
+        self.fixed.add(i)
+        self.valid_until = -np.inf
+        if not isl.members:
+            self._retire(isl)
+
+    def from_fixed(self, i: int) -> bool:
+        """FIXED obstacle i wakes: the islands holding it merge into one, where it is a
+        member at rest, its pairs going on. False if no island holds it."""
+        holders = [isl for isl in self.islands if i in isl.fixed]
+        self.fixed.discard(i)
+        if not holders:
+            return False
+        if len(holders) > 1:
+            merged = [m for isl in holders for m in isl.members]
+            others = [isl.members for isl in self.islands if isl not in holders]
+            self._regroup([merged] + others)
+            holders = [self.of[merged[0]]]
+        isl = holders[0]
+        isl.from_fixed(i)
+        self.of[i] = isl
+        self.members.append(i)
+        self.valid_until = -np.inf
+        return True
+
     def remove(self, i: int):
         """Ball i leaves its island (an island left empty is dropped)."""
         isl = self.of.pop(i)
@@ -126,21 +180,27 @@ class Islands:
         if isl is self.newcomers:
             self.newcomers = None
 
-    def _regroup(self, groups, watch=None) -> None:
+    def _regroup(self, groups, watch=None, fixed=None) -> None:
         """Make the islands ``groups`` (lists of balls): an island whose members stay
         together is kept as it is; the others are rebuilt from their balls' islands.
         ``watch``: the ball pairs that can touch (``group``; None: the new islands watch
-        every pair of their members, the kept ones what they watched)."""
+        every pair of their members, the kept ones what they watched). ``fixed``: each
+        group's FIXED obstacles (None: those of the islands its balls come from)."""
         kept = {frozenset(isl.members): isl for isl in self.islands}
         new = []
-        for g in groups:
+        for q, g in enumerate(groups):
             isl = kept.pop(frozenset(g), None)
+            parts = list(dict.fromkeys(self.of[i] for i in g))
+            obstacles = [k for p in parts for k in p.fixed] if fixed is None else fixed[q]
             if isl is None:
                 isl = self._new()
-                isl.adopt(g, [p.export() for p in dict.fromkeys(self.of[i] for i in g)])
+                isl.adopt(g, [p.export() for p in parts])
                 isl.watch = watch
-            elif watch is not None:
-                _narrow(isl, watch)
+                isl.set_fixed(obstacles)
+            else:
+                isl.set_fixed(obstacles)
+                if watch is not None:
+                    _narrow(isl, watch)
             new.append(isl)
         for isl in kept.values():  # (their members are in the new islands now)
             self._retire(isl)
@@ -185,11 +245,12 @@ class Islands:
             out[ks] = isl.ball_energies([balls[k] for k in ks])
         return out
 
-    def group(self, horizon: float) -> tuple[list, set]:
+    def group(self, horizon: float) -> tuple[list, set, list]:
         """The islands for the next ``horizon`` (s): touching balls together, then groups
         whose balls could come into contact within it (``speed_bounds``) merged until none
-        can. Returns the islands (lists of balls, in member order) and the pairs (i, j),
-        i < j, that could touch within it (each island watches only those)."""
+        can. Returns the islands (lists of balls, in member order), the pairs (i, j), i < j,
+        that could touch within it (each island watches only those) and each island's FIXED
+        obstacles (a FIXED ball joins no two islands: it moves neither)."""
         m = list(self.members)
         pos = {i: q for q, i in enumerate(m)}
         root = list(range(len(m)))
@@ -202,7 +263,7 @@ class Islands:
 
         for isl in self.islands:
             for i, j in isl.touching_keys():
-                if j >= 0:
+                if j >= 0 and i in pos and j in pos:  # (not through a FIXED obstacle)
                     root[find(pos[i])] = find(pos[j])
         x = self.positions(m)
         r = self.balls.radius[m]
@@ -222,7 +283,28 @@ class Islands:
                     joined = True
             if not joined:
                 watch = {(min(m[a], m[c]), max(m[a], m[c])) for a, c in zip(qi, qj, strict=True)}
-                return groups, watch
+                fixed = self._obstacles(groups, m, x, r, sv, horizon, watch)
+                return groups, watch, fixed
+
+    def _obstacles(self, groups, m, x, r, sv, horizon: float, watch: set) -> list:
+        """Each group's FIXED obstacles: those a member could touch within ``horizon`` at
+        its speed bound ``sv`` (the members ``m`` at ``x``, radii ``r``); their pairs go into
+        ``watch``."""
+        out = [[] for _ in groups]
+        if not self.fixed:
+            return out
+        fixed = sorted(self.fixed)
+        xf = self.positions(fixed)
+        rf = self.balls.radius[fixed]
+        d2 = np.sum((x[:, None, :] - xf[None, :, :]) ** 2, axis=2)
+        near = d2 <= (r[:, None] + rf[None, :] + sv[:, None] * horizon) ** 2
+        group_of = {i: q for q, g in enumerate(groups) for i in g}
+        for a, c in zip(*np.nonzero(near), strict=True):
+            i, k = m[a], fixed[c]
+            if k not in out[group_of[i]]:
+                out[group_of[i]].append(k)
+            watch.add((min(i, k), max(i, k)))
+        return out
 
     # --- integration ------------------------------------------------------------------------
     def next_event(self, t: float, t_stop: float):
@@ -282,7 +364,8 @@ class Islands:
             return key in self.of
         if code == EventCode.LEAVE:
             return key[0] in self.of
-        return all(i in self.of for i in key if i >= 0)
+        inside = [i in self.of for i in key if i >= 0]
+        return any(inside) and all(i in self.of or i in self.fixed for i in key if i >= 0)
 
     def steps(self) -> int:
         """Kernel steps so far (accepted)."""
@@ -302,8 +385,12 @@ class Islands:
 
     # --- state (by ball) ----------------------------------------------------------------------
     def state(self, i: int):
-        """Position (m) and velocity (m/s) of member i now."""
-        return self.of[i].state(i)
+        """Position (m) and velocity (m/s) of member i now (a FIXED obstacle's: where it is
+        held, at rest)."""
+        isl = self.of.get(i)
+        if isl is None:
+            return self.balls.x0[i].copy(), np.zeros(3)
+        return isl.state(i)
 
     def positions(self, idx) -> np.ndarray:
         """Positions (len(idx), 3) m of members ``idx`` now."""
@@ -312,7 +399,7 @@ class Islands:
     def spin(self, i: int) -> np.ndarray:
         """Angular velocity (3,) rad/s of ball i now."""
         isl = self.of.get(i)
-        return isl.spin(i) if isl is not None else self._new().spin(i)
+        return isl.spin(i) if isl is not None else self.balls.w[i].copy()
 
     def sync_spins(self):
         """Bring ``balls.w`` up to date with the islands."""
@@ -336,26 +423,40 @@ class Islands:
         return [k for isl in self.islands for k in isl.touching_keys()]
 
     def touching_pairs(self, i: int) -> list:
-        """Keys of member i's pairs in contact now."""
-        return self.of[i].touching_pairs(i)
+        """Keys of member i's pairs in contact now (of a FIXED obstacle: in every island)."""
+        if i in self.of:
+            return self.of[i].touching_pairs(i)
+        return [k for isl in self.islands if i in isl.fixed for k in isl.touching_pairs(i)]
+
+    def _holder(self, key):
+        """The island of pair ``key`` (that of its member: a FIXED partner is in several)."""
+        return self.of[key[0]] if key[0] in self.of else self.of[key[1]]
+
+    def contact_loads(self, key) -> tuple:
+        """As ``ActiveMembers.contact_loads``."""
+        return self._holder(key).contact_loads(key)
+
+    def pair_energy(self, key) -> float:
+        """As ``ActiveMembers.pair_energy``."""
+        return self._holder(key).pair_energy(key)
 
     # --- contacts -------------------------------------------------------------------------------
     def start_contact(self, key):
         """Pair ``key`` starts touching now (found in closed form): its balls' islands merge."""
-        balls = [k for k in key if k >= 0]
+        balls = [k for k in key if k >= 0 and k in self.of]
         isl = self._merge(balls)
         if isl.watch is not None and key[1] >= 0 and key not in isl.watch:
             isl.rewatch(None)  # (not found by the island itself: watch every pair)
         isl.start_contact(key)
 
     def impulses(self, key) -> np.ndarray:
-        return self.of[key[0]].impulses(key)
+        return self._holder(key).impulses(key)
 
     def reset_accumulators(self, key):
-        self.of[key[0]].reset_accumulators(key)
+        self._holder(key).reset_accumulators(key)
 
     def accumulators(self, key):
-        return self.of[key[0]].accumulators(key)
+        return self._holder(key).accumulators(key)
 
     def make_quiet(self, i: int) -> float:
         return self.of[i].make_quiet(i)
@@ -384,8 +485,8 @@ def _cost(isl) -> float:
 def _narrow(isl, watch) -> None:
     """Island ``isl`` (kept) watches the pairs of ``watch`` among its members: rebuilt when
     it misses one of them or watches more than twice as many (and 8) as needed."""
-    members = set(isl.members)
-    need = {k for k in watch if k[0] in members and k[1] in members}
+    members, both = set(isl.members), set(isl.members) | set(isl.fixed)
+    need = {k for k in watch if (k[0] in members or k[1] in members) and set(k) <= both}
     have = {k for k in isl.keys if k[1] >= 0} if not isl.dirty else None
     if have is None or not need <= have or len(have) > 2 * len(need) + 8:
         isl.rewatch(watch)

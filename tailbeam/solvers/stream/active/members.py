@@ -9,6 +9,10 @@ balls near a contact). A set rebuilt at the instant of an event carries the rows
 were applied then (``carry.CarriedRows``), so that it does not apply the same event again at
 once (``kernel.advance``).
 
+With friction a set may also carry FIXED obstacles (``set_fixed``): sleeping balls held
+where they are, whose pairs with the members act on the members only (the kernel's
+``pairs.FIXED``); two of them never form a pair.
+
 Its parts: the plate force histories (``plate.forces.PlateForces``), putting a member at rest
 (``plate.rest``) and, on the modal plate, the plate pairs' shapes, compliance and tails
 (``plate.pairs.PlatePairs``).
@@ -82,6 +86,7 @@ class ActiveMembers:
         self.carried = CarriedRows()
         self.now = 0.0
         self.members, self.quiet = [], set()  # quiet: members resting on the plate
+        self.fixed = []  # FIXED obstacles: sleeping balls the members may touch (``fix``)
         self.keys, self.index, self.local, self.pairs_of = [], {}, {}, {}
         self.set, self.dirty, self.h = None, True, 0.0
         self.watch = None  # ball pairs watched (None: every pair of members; ``rewatch``)
@@ -110,6 +115,51 @@ class ActiveMembers:
         if quiet:
             self.quiet.add(i)
         self.dirty = True
+
+    def set_fixed(self, balls) -> None:
+        """The sleeping balls ``balls`` are the set's FIXED obstacles from now: held where
+        they are (``balls.x0``, at rest), acting on the members that touch them and feeling
+        nothing; pairs of two of them are not in the set (rebuilt on its next use)."""
+        balls = list(dict.fromkeys(int(k) for k in balls))
+        if balls == self.fixed:
+            return
+        self._sync()
+        self.fixed = balls
+        self.dirty = True
+
+    def to_fixed(self, i: int) -> None:
+        """Member i, frozen now (its velocity and spin set to 0 by the caller), stays in the
+        set as a FIXED obstacle, its touching pairs with the members going on."""
+        self._sync()
+        self.members.remove(i)
+        self._x.pop(i, None)
+        self._v.pop(i, None)
+        self.quiet.discard(i)
+        self.fixed.append(i)
+        self.dirty = True
+
+    def add_fixed(self, k: int, owner=None) -> None:
+        """Sleeping ball k is a FIXED obstacle of the set (``set_fixed``; ``owner``: as
+        ``Islands.add_fixed``)."""
+        if k not in self.fixed:
+            self.set_fixed(self.fixed + [k])
+
+    def remove_fixed(self, k: int) -> None:
+        """Ball k is no FIXED obstacle any more."""
+        if k in self.fixed:
+            self.set_fixed([f for f in self.fixed if f != k])
+
+    def from_fixed(self, i: int) -> bool:
+        """FIXED obstacle i becomes a member, at rest where it is, its pairs going on (False:
+        not an obstacle of the set)."""
+        if i not in self.fixed:
+            return False
+        self._sync()
+        self.fixed.remove(i)
+        self.members.append(i)
+        self._x[i], self._v[i] = self.balls.x0[i].copy(), np.zeros(3)
+        self.dirty = True
+        return True
 
     def remove(self, i: int):
         """Ball i leaves the set."""
@@ -165,10 +215,11 @@ class ActiveMembers:
         carried rows, next step), for an ``adopt`` by another set (an island's members
         regrouped, ``islands``); spins go to ``balls.w``."""
         self._sync()
-        mine = set(self.members)
+        mine, fixed = set(self.members), set(self.fixed)
         pairs = {
-            k: st for k, st in self._pairs.items() if k[0] in mine and (k[1] < 0 or k[1] in mine)
-        }
+            k: st for k, st in self._pairs.items()
+            if (k[0] in mine or k[1] in mine) and all(i < 0 or i in mine or i in fixed for i in k)
+        }  # fmt: skip
         return dict(x=dict(self._x), v=dict(self._v), pairs=pairs,
                     quiet=set(self.quiet), carried=(self.carried.t, list(self.carried.rows)),
                     h=self.h)  # fmt: skip
@@ -205,13 +256,16 @@ class ActiveMembers:
 
     def _build(self):
         self.flush_forces()  # (the rows name the pairs of the set replaced)
-        b, m = self.balls, self.members
+        b, m = self.balls, self.members + self.fixed
         old = self._pairs
-        self.keys = [(i, -1) for i in m] + self._ball_pairs(old)
+        self.keys = [(i, -1) for i in self.members] + self._ball_pairs(old)
         local = {i: q for q, i in enumerate(m)}
         pairs = [(local[i], -1 if j < 0 else local[j]) for i, j in self.keys]
         laws = [b.table.law(i, PLATE if j < 0 else j) for i, j in self.keys]
-        settle = [0.0 if i in self.quiet else self.settle_energy(i) for i in m]
+        settle = [0.0 if i in self.quiet else self.settle_energy(i) for i in self.members]
+        settle += [0.0] * len(self.fixed)
+        x = [self._x[i] for i in self.members] + [b.x0[i] for i in self.fixed]
+        v = [self._v[i] for i in self.members] + [np.zeros(3)] * len(self.fixed)
         self._count()
         modal = {} if self.modal is None else self.modal.block(m, self.keys, self._x,
                                                                 self.quiet, self.now)  # fmt: skip
@@ -219,10 +273,12 @@ class ActiveMembers:
             table = self.friction.table(self.keys, **self._plate_friction(modal))
             modal = {**modal, "friction": table, "w": b.w[m]}
         self.set = s = ActiveSet(
-            [self._x[i] for i in m], [self._v[i] for i in m], b.mass[m], b.radius[m],
+            x, v, b.mass[m], b.radius[m],
             np.array(pairs, dtype=np.int64).reshape(-1, 2), law_table(laws), b.g, b.half,
             settle_energy=np.array(settle), rtol=self.rtol, **modal,
         )  # fmt: skip
+        for i in self.fixed:
+            s.model.fix(local[i])
         self.index = {k: p for p, k in enumerate(self.keys)}
         self.pairs_of = {}  # ball -> its pairs, in the set's order
         for p, (i, j) in enumerate(self.keys):
@@ -240,10 +296,12 @@ class ActiveMembers:
         self.totals["rebuilds"] += 1
 
     def _ball_pairs(self, old) -> list:
-        """The ball-ball pair keys the set watches: every pair of members, or those in
-        ``watch`` and those touching (``old``: the pair states by key)."""
+        """The ball-ball pair keys the set watches: every pair of members and of a member and
+        a FIXED obstacle, or those in ``watch`` and those touching (``old``: the pair states
+        by key)."""
         m = self.members
         keys = [(min(i, j), max(i, j)) for a, i in enumerate(m) for j in m[a + 1 :]]
+        keys += [(min(i, k), max(i, k)) for i in m for k in self.fixed]
         if self.watch is None:
             return keys
         return [k for k in keys if k in self.watch or (k in old and old[k][0])]
@@ -365,7 +423,10 @@ class ActiveMembers:
 
     # --- state ------------------------------------------------------------------------------
     def state(self, i: int):
-        """Position (m) and velocity (m/s) of member i now."""
+        """Position (m) and velocity (m/s) of member i now (a FIXED obstacle's: where it is
+        held, at rest)."""
+        if i in self.fixed:
+            return self.balls.x0[i].copy(), np.zeros(3)
         if self.dirty:
             return self._x[i], self._v[i]
         q = self.local[i]
@@ -391,8 +452,9 @@ class ActiveMembers:
     def ball_energies(self, balls) -> np.ndarray:
         """Per ball of ``balls`` (members): its kinetic energy (rotation included with
         friction), its plate contact's elastic energy and half of each of its touching
-        ball-ball pairs' (J): summed over a group holding both balls of each of its pairs,
-        the group's kinetic and elastic energy."""
+        ball-ball pairs' (all of a pair with a FIXED obstacle, which takes none) (J): summed
+        over a group holding both balls of each of its pairs, the group's kinetic and elastic
+        energy."""
         s = self._ready()
         q = np.array([self.local[int(i)] for i in balls], dtype=np.int64)
         m = s.model.mass[q]
@@ -404,9 +466,10 @@ class ActiveMembers:
             return out
         energies = s.contact_energies()
         where = {int(i): k for k, i in enumerate(balls)}
+        fixed = set(self.fixed)
         for p in touching.tolist():
             i, j = self.keys[p]
-            e = energies[p] if j < 0 else 0.5 * energies[p]
+            e = energies[p] if j < 0 or i in fixed or j in fixed else 0.5 * energies[p]
             for k in (i, j):
                 if k in where:
                     out[where[k]] += e
@@ -415,13 +478,25 @@ class ActiveMembers:
     def elastic_energy_of(self, i: int, ball_share: float = 0.5) -> float:
         """Elastic energy (J) of member i's touching plate pair plus ``ball_share`` of each of
         its touching ball-ball pairs (half: the other half is its partner's; 1: the pairs
-        vanish with i, as when it leaves over an edge)."""
+        vanish with i, as when it leaves over an edge); all of a pair with a FIXED obstacle
+        (the ledger books none of it with the obstacle)."""
         s = self._ready()
         total = 0.0
         for key in self.touching_pairs(i):
-            share = 1.0 if key[1] < 0 else ball_share
+            alone = key[1] < 0 or key[0] in self.fixed or key[1] in self.fixed
+            share = 1.0 if alone else ball_share
             total += share * s.contact_energy(self.index[key])
         return total
+
+    def contact_loads(self, key) -> tuple:
+        """Touching pair ``key``'s loads now: (force (3,) N, torque (3,) N m) on each of its
+        balls (the second None on the plate) (``ActiveSet.contact_loads``)."""
+        fi, ti, fj, tj = self._ready().contact_loads(self.index[key])
+        return (fi, ti), (None if key[1] < 0 else (fj, tj))
+
+    def pair_energy(self, key) -> float:
+        """Elastic energy (J) of pair ``key`` now (0 when not touching)."""
+        return self._ready().contact_energy(self.index[key])
 
     def touching_keys(self) -> list:
         """Keys of every pair in contact now."""

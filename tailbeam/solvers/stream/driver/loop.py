@@ -19,8 +19,9 @@ penetration and it slides frictionlessly downhill in closed form (its normal osc
 below the rest energy, is dropped: the energy removed is counted in
 ``stats["rest_energy_removed"]``, ``energy``). A slider that something approaches joins the
 active set again, at its static state (an equilibrium of the full model, so nothing jumps).
-With friction (rigid plate) a resting cluster in static equilibrium within its Coulomb and
-rolling limits is frozen instead, and woken by a touch (``sleep``).
+With friction (rigid plate) a resting group in static equilibrium within its Coulomb and
+rolling limits is frozen instead, a fixed obstacle for the balls that move on it, and a
+frozen ball is woken by a touch or by a load it cannot bear (``sleep``).
 
 Contacts are recorded as ``Impact`` (one per ball per contact; ``end`` an ``End``:
 separated, rest, left or duration; ``records``); the plate's contact forces are kept as

@@ -6,9 +6,9 @@ every closed-form ball that could reach a core ball within SET_HORIZON (certifie
 A core ball that touches nothing any more flies (or slides, resting on the plate) in closed
 form again. A plate contact alone past its rest limit (``records``) is put at rest. On the
 modal plate the set's horizon is also bounded by SHAPE_TRAVEL of lateral travel of its
-landing balls (their mode shapes are refreshed then). With friction on the rigid plate, a
-resting cluster of core balls is frozen and a sleeping ball that could be reached wakes its
-cluster (``sleep``).
+landing balls (their mode shapes are refreshed then). With friction on the rigid plate,
+resting groups of core balls are frozen, a sleeping ball that a core ball could reach is a
+FIXED obstacle of the set, and a touch wakes it alone (``sleep``).
 """
 
 import numpy as np
@@ -55,20 +55,37 @@ class Membership:
         self.landing = set()  # modal plate: balls within the deflection bound, touching nothing
         self.held = {}  # ball -> time (s) of a contact end: core until time moves on
         self.set_end = 0.0  # s: the set's horizon
+        if sleepers is not None:
+            sleepers.make_core = self._make_core
 
     # --- contacts starting and ending -------------------------------------------------------
     def start(self, key) -> None:
-        """Contact ``key`` starts now: its record; its balls are core."""
+        """Contact ``key`` starts now: its record; its balls are core (a sleeping one, a
+        FIXED obstacle, stays asleep unless the touch wakes it: ``Sleepers.wakes_on_touch``)."""
         self.landing.discard(key[0])
         self.records.start(key)
+        b = self.balls
+        asleep = [k for k in key if k >= 0 and b.status[k] == SLEEP]
         for k in key:
-            if k >= 0:
+            if k >= 0 and k not in asleep:
                 self._make_core(k)
+        if asleep and self.sleepers.wakes_on_touch(key):
+            for k in asleep:
+                self.sleepers.wake(k)
 
     def join(self, ids, key) -> None:
-        """Closed-form balls ``ids`` start the contact ``key`` now (found in closed form)."""
+        """Closed-form balls ``ids`` start the contact ``key`` now (found in closed form); a
+        sleeping one touched slowly stays asleep, a FIXED obstacle (``Sleepers``)."""
+        b = self.balls
+        asleep = [i for i in ids if b.status[i] == SLEEP]
+        if len(asleep) == 1 and len(ids) == 2 and not self.sleepers.wakes_on_touch(key):
+            other = ids[0] if ids[1] == asleep[0] else ids[1]
+            if not b.in_set[other]:
+                self._absorb(other)
+            self.act.add_fixed(asleep[0], owner=other)
+            ids = [other]
         for i in ids:
-            if not self.balls.in_set[i]:
+            if not b.in_set[i]:
                 self._absorb(i)
         self.act.start_contact(key)
         self.start(key)
@@ -120,17 +137,32 @@ class Membership:
         if not len(core):
             for i in cand[b.in_set[cand]]:
                 self._exit(int(i))
+            self._obstacles(set())
             self.set_end = t
             return
         self.set_end = self._horizon(core)
         near = self._near(cand, core)
         if near is None:
+            self._obstacles(set())
             return
-        for i in cand[near & ~b.in_set[cand]]:
+        asleep = b.status[cand] == SLEEP
+        self._obstacles({int(i) for i in cand[near & asleep]})
+        for i in cand[near & ~b.in_set[cand] & ~asleep]:
             self._absorb_near(int(i))
         for i in cand[~near & b.in_set[cand]]:
             if b.status[i] != ACTIVE:  # (not a ball of a cluster woken just now)
                 self._exit(int(i))
+
+    def _obstacles(self, needed) -> None:
+        """The sleeping balls ``needed`` (a core ball could reach them within SET_HORIZON)
+        are the set's FIXED obstacles; the others are not (``Sleepers``)."""
+        if self.sleepers is None:
+            return
+        for k in sorted(needed - set(self.act.fixed)):
+            self.act.add_fixed(k)
+            self.clock.count("fixed_obstacles")
+        for k in sorted(set(self.act.fixed) - needed):
+            self.act.remove_fixed(k)
 
     def _horizon(self, core) -> float:
         """The set's horizon (s): SET_HORIZON ahead, or a core ball's rest limit, or (modal
@@ -222,7 +254,7 @@ class Membership:
         if b.in_set[i]:  # (woken with its cluster)
             return
         if b.status[i] == SLEEP:
-            self.sleepers.wake(i, self._make_core)
+            self.sleepers.wake(i)
             return
         if b.status[i] == SLIDE:
             self.loads.dead_load(i, t)

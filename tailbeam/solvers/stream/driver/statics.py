@@ -38,7 +38,7 @@ def tangent_basis(n) -> tuple:
     return t1, np.cross(n, t1)
 
 
-def in_equilibrium(x, mass, gravity, contacts) -> bool:
+def in_equilibrium(x, mass, gravity, contacts, loads=None) -> bool:
     """Whether balls at positions ``x`` can stand still on their contacts.
 
     Parameters
@@ -53,6 +53,9 @@ def in_equilibrium(x, mass, gravity, contacts) -> bool:
         (i, j, share, mu_s, mu_r, rolling_radius): ball i (local index) touching the plate
         (j = -1) or ball j; ``share`` the contact point's fraction r_i / (r_i + r_j) of the
         centres' distance from i (1 on the plate); mu_s, mu_r dimensionless; rolling radius m.
+    loads : ndarray, shape (n, 6), optional
+        Given external loads on each ball besides its weight: force (N) and torque about its
+        centre (N m), plate frame (the contacts of balls outside the cluster, as they are).
     """
     x = np.asarray(x, dtype=float).reshape(-1, 3)
     n_balls, n_c = x.shape[0], len(contacts)
@@ -89,6 +92,8 @@ def in_equilibrium(x, mass, gravity, contacts) -> bool:
     b_eq = np.zeros(6 * n_balls)
     for i in range(n_balls):
         b_eq[6 * i : 6 * i + 3] = -np.asarray(mass)[i] * np.asarray(gravity, dtype=float)
+    if loads is not None:
+        b_eq -= np.asarray(loads, dtype=float).reshape(6 * n_balls)
     bounds = [(0.0, None) if c % 5 == 0 else (None, None) for c in range(5 * n_c)]
     scale = float(np.max(np.abs(b_eq))) or 1.0
     res = linprog(np.zeros(5 * n_c), A_ub=a_ub, b_ub=np.zeros(len(a_ub)), A_eq=a_eq,

@@ -23,6 +23,7 @@ from tailbeam.solvers.numerics.chebyshev import (
 )
 from tailbeam.solvers.numerics.jit import helper_njit
 from tailbeam.solvers.stream.active.compiled.pairs import (
+    INTEGRATED,
     L_CRES,
     R_CLAMP,
     R_CONTACT,
@@ -183,7 +184,7 @@ def detect(dense, fresh, nfresh, pts, vinv, model, pstate, ws):
                 best_s, best_k, best_i = s, kind, p
     kind_edge = np.int64(R_EDGE)  # (typed like the pair kinds: one compiled signature)
     for b in range(n):
-        if not alive[b]:
+        if alive[b] != INTEGRATED:  # (gone, or a FIXED obstacle: it does not move)
             continue
         for e in range(4):
             fr = is_fresh(kind_edge, 4 * b + e, fresh, nfresh)  # (False: LEAVE returns)

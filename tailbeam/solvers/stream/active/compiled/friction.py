@@ -125,18 +125,23 @@ def add_plate_moment(n, p, fx, fy, fric, out):
 
 
 @helper_njit
-def add_friction(y, n, off, p, i, j, fn, nx, ny, nz, mass, radius, fric, out):
+def add_friction(y, n, off, p, i, j, fn, nx, ny, nz, mass, radius, fric, fixed_i, fixed_j,
+                 out):  # fmt: skip
     """Add pair p's friction force and torques to dy/dt ``out`` (accelerations, angular
     accelerations with the moment of inertia 2/5 m r^2; on the modal plate the modes'
-    accelerations from the force's moment, ``add_plate_moment``)."""
+    accelerations from the force's moment, ``add_plate_moment``). A ball ``fixed_i`` /
+    ``fixed_j`` (an obstacle, ``pairs.FIXED``) takes none of it."""
     r = pair_friction(y, n, off, i, j, p, nx, ny, nz, fn, fric)
     vi, wi = 3 * n + 3 * i, off + 3 * i
     inertia = 0.4 * mass[i] * radius[i] * radius[i]
-    for k in range(3):
-        out[vi + k] += r[k] / mass[i]
-    out[wi] += r[3] / inertia
-    out[wi + 1] += r[4] / inertia
-    out[wi + 2] += r[5] / inertia
+    if not fixed_i:
+        for k in range(3):
+            out[vi + k] += r[k] / mass[i]
+        out[wi] += r[3] / inertia
+        out[wi + 1] += r[4] / inertia
+        out[wi + 2] += r[5] / inertia
+    if j >= 0 and fixed_j:
+        return
     if j >= 0:
         vj, wj = 3 * n + 3 * j, off + 3 * j
         inertia = 0.4 * mass[j] * radius[j] * radius[j]

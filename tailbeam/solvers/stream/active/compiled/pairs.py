@@ -59,6 +59,9 @@ L_CRES = LAW_COLUMNS  # the residual compliance C (m/N), after the law's own col
 RESIDUAL_RTOL = 1e-14  # relative convergence of the residual-flexibility force solve
 RESIDUAL_ITERATIONS = 60  # its bound (bisection safeguard: ~1 bit per iteration at worst)
 R_CONTACT, R_FULL, R_CLAMP, R_EDGE = range(4)
+# a ball's ``alive`` code: gone (no longer integrated), integrated, or a FIXED obstacle (held
+# where it is: no motion, no gravity, feels no force; its pairs act on the other ball only)
+GONE, INTEGRATED, FIXED = 0, 1, 2
 CLAMP_BAND = 1e-10
 EDGE_BAND = 1e-13
 
@@ -224,7 +227,8 @@ def plate_force(p, z, vz, w, wd, acc, kappa, law, rsum, ramp, clamped):
 @helper_njit
 def rhs_arrays(y, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, omega, zeta,
                phi, fdead, radius, fric, out):  # fmt: skip
-    """dy/dt of the active set: gravity on every present ball plus the touching pairs, and the
+    """dy/dt of the active set: gravity on every integrated ball plus the touching pairs (a
+    FIXED ball's derivatives stay 0: it acts on its partners and feels nothing), and the
     modes (``_modal_rhs``); with friction (``fric`` has columns) the angular velocities'
     rates and each touching pair's friction (``friction.add_friction``). (Arrays passed one
     by one: unpacking the model tuple on every call costs more than the right-hand side of a
@@ -232,8 +236,8 @@ def rhs_arrays(y, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, om
     n = mass.shape[0]
     for b in range(n):
         for k in range(3):
-            out[3 * b + k] = y[3 * n + 3 * b + k] if alive[b] else 0.0
-            out[3 * n + 3 * b + k] = g[k] if alive[b] else 0.0
+            out[3 * b + k] = y[3 * n + 3 * b + k] if alive[b] == INTEGRATED else 0.0
+            out[3 * n + 3 * b + k] = g[k] if alive[b] == INTEGRATED else 0.0
     _modal_rhs(y, n, omega, zeta, fdead, out)
     with_friction = fric.shape[1] > 0
     off = spin_offset(n, omega.shape[0])
@@ -250,17 +254,19 @@ def rhs_arrays(y, mass, g, pi, pj, law, rsum, touching, ramp, clamped, alive, om
         i, j = pi[p], pj[p]
         if j < 0:
             _plate_reaction(n, phi, p, f, out)
-        a = f / mass[i]
-        out[3 * n + 3 * i] += a * nx
-        out[3 * n + 3 * i + 1] += a * ny
-        out[3 * n + 3 * i + 2] += a * nz
-        if j >= 0:
+        if alive[i] != FIXED:
+            a = f / mass[i]
+            out[3 * n + 3 * i] += a * nx
+            out[3 * n + 3 * i + 1] += a * ny
+            out[3 * n + 3 * i + 2] += a * nz
+        if j >= 0 and alive[j] != FIXED:
             a = f / mass[j]
             out[3 * n + 3 * j] -= a * nx
             out[3 * n + 3 * j + 1] -= a * ny
             out[3 * n + 3 * j + 2] -= a * nz
         if with_friction:
-            add_friction(y, n, off, p, i, j, f, nx, ny, nz, mass, radius, fric, out)
+            add_friction(y, n, off, p, i, j, f, nx, ny, nz, mass, radius, fric, alive[i] == FIXED,
+                         j >= 0 and alive[j] == FIXED, out)  # fmt: skip
 
 
 @helper_njit
@@ -384,6 +390,10 @@ def first_contact_step(y, model, p, rtol):
     n = mass.shape[0]
     i, j = pi[p], pj[p]
     m = mass[i] if j < 0 else mass[i] * mass[j] / (mass[i] + mass[j])
+    if j >= 0 and alive[j] == FIXED:  # (an obstacle: the other ball's mass alone)
+        m = mass[i]
+    elif alive[i] == FIXED:
+        m = mass[j]
     _, rate, _, _, _ = pair_state(y, n, i, j, rsum[p], phi, p)
     speed = max(rate, 1e-3)
     k, e = law[p, LAW_K], law[p, LAW_E]

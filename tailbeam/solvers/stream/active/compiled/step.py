@@ -17,7 +17,7 @@ import numpy as np
 
 from tailbeam.solvers.numerics.dop853 import dense_rows
 from tailbeam.solvers.numerics.jit import helper_njit
-from tailbeam.solvers.stream.active.compiled.pairs import rhs, rhs_arrays
+from tailbeam.solvers.stream.active.compiled.pairs import FIXED, rhs, rhs_arrays
 
 EPS = 2.220446049250313e-16
 
@@ -46,6 +46,7 @@ def dop853_step(y, h, K, tab, rtol, atol, model, pstate, ynew, tmp):
     A, B = tab[0], tab[1]
     n = y.shape[0]
     nb6 = 6 * model[0].shape[0]  # balls' positions and velocities, then the modal block
+    nfixed = fixed_count(model[9])  # (their components never change: not in the norm's count)
     stages(K, A, np.int64(1), np.int64(12), y, h, model, pstate, tmp)
     for q in range(n):
         acc = 0.0
@@ -53,17 +54,19 @@ def dop853_step(y, h, K, tab, rtol, atol, model, pstate, ynew, tmp):
             acc += B[j] * K[j, q]
         ynew[q] = y[q] + h * acc
     rhs(ynew, model, pstate, K[12])
-    err = block_error(y, ynew, h, K, tab, rtol, atol, np.int64(0), nb6)
+    err = block_error(y, ynew, h, K, tab, rtol, atol, np.int64(0), nb6, nb6 - 6 * nfixed)
     if n > nb6 and err == err:
-        err_modes = block_error(y, ynew, h, K, tab, rtol, atol, nb6, n)
+        spins = 3 * nfixed if model[14].shape[1] > 0 else 0
+        err_modes = block_error(y, ynew, h, K, tab, rtol, atol, nb6, n, n - nb6 - spins)
         if not err_modes <= err:
             err = err_modes
     return err
 
 
 @helper_njit
-def block_error(y, ynew, h, K, tab, rtol, atol, lo, hi):
-    """scipy's DOP853 error norm over the components lo..hi-1."""
+def block_error(y, ynew, h, K, tab, rtol, atol, lo, hi, count):
+    """scipy's DOP853 error norm over the components lo..hi-1, ``count`` of them counted
+    (those of FIXED balls, exactly constant, are not)."""
     E3, E5 = tab[2], tab[3]
     err5 = 0.0
     err3 = 0.0
@@ -78,7 +81,17 @@ def block_error(y, ynew, h, K, tab, rtol, atol, lo, hi):
         err3 += (e3 / sc) ** 2
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
-    return h * err5 / math.sqrt((err5 + 0.01 * err3) * (hi - lo))
+    return h * err5 / math.sqrt((err5 + 0.01 * err3) * count)
+
+
+@helper_njit
+def fixed_count(alive):
+    """How many balls are FIXED obstacles (``pairs.FIXED``)."""
+    c = 0
+    for b in range(alive.shape[0]):
+        if alive[b] == FIXED:
+            c += 1
+    return c
 
 
 @helper_njit

@@ -14,7 +14,7 @@ import numpy as np
 from tailbeam.errors import InputError
 from tailbeam.physics.contact_law import LAW_COLUMNS, law_table
 from tailbeam.solvers.stream.active.compiled.friction import F_COLUMNS, F_GRAD
-from tailbeam.solvers.stream.active.compiled.pairs import L_CRES
+from tailbeam.solvers.stream.active.compiled.pairs import FIXED, INTEGRATED, L_CRES
 
 
 class Model:
@@ -62,8 +62,9 @@ class Model:
         Sum of the pair's radii (m; the ball's alone for a plate pair).
     settle_energy : ndarray, shape (n,)
         J, in/out (the caller puts a ball at rest or wakes it).
-    alive : ndarray of bool, shape (n,)
-        Balls still integrated (False after a leave).
+    alive : ndarray of int8, shape (n,)
+        Each ball's code (``pairs``): INTEGRATED, GONE (after a leave) or FIXED (an obstacle
+        held where it is, ``fix``).
     omega, zeta, f_dead : ndarray, shape (m,)
         Modal frequencies (rad/s), damping ratios, constant modal forces (N/sqrt(kg)).
     phi : ndarray, shape (P, m)
@@ -93,7 +94,7 @@ class Model:
         self.settle_energy = np.asarray(settle, dtype=float).reshape(n).copy()
         if not np.all(self.settle_energy >= 0.0):
             raise InputError("settle_energy", "must be >= 0 J for every ball (0 = never)")
-        self.alive = np.ones(n, dtype=bool)
+        self.alive = np.full(n, INTEGRATED, dtype=np.int8)
         self.omega, self.zeta = modes.omega, modes.zeta
         self.phi, self.f_dead = modes.phi, modes.f_dead
         self.fric = _friction_table(friction, len(self.pi), self.omega.shape[0])
@@ -108,6 +109,12 @@ class Model:
         return (self.mass, self.radius, self.g, self.half, self.pi, self.pj, self.law,
                 self.rsum, self.settle_energy, self.alive, self.omega, self.zeta, self.phi,
                 self.f_dead, self.fric)  # fmt: skip
+
+    def fix(self, b: int) -> None:
+        """Ball b is a FIXED obstacle from now: held where it is (its velocity and angular
+        velocity must be 0 in the state), feeling no force, its pairs acting on their other
+        ball only."""
+        self.alive[b] = FIXED
 
     def set_phi(self, p: int, shape) -> None:
         """Mode shapes (m,) 1/sqrt(kg) at plate pair p's new contact point (before it touches)."""

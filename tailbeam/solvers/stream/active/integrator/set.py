@@ -54,9 +54,12 @@ from tailbeam.physics.contacts import PLATE, ContactTable, LawOptions
 from tailbeam.solvers.numerics.chebyshev import tables as cheb_tables
 from tailbeam.solvers.numerics.dop853 import dop853_tables
 from tailbeam.solvers.stream.active.compiled import kernel as ak
+from tailbeam.solvers.stream.active.compiled.friction import pair_friction, spin_offset
 from tailbeam.solvers.stream.active.compiled.pairs import (
+    GONE,
     L_CRES,
     contact_energies,
+    pair_force,
     pair_state,
     plate_contact_energy,
 )
@@ -233,6 +236,24 @@ class ActiveSet:
         k, e, cres = law[p, LAW_K], law[p, LAW_E], law[p, L_CRES]
         return float(plate_contact_energy(delta, k, e, cres if self.model.pj[p] < 0 else 0.0))
 
+    def contact_loads(self, p: int) -> tuple:
+        """Pair p's loads now (touching): (force (3,) N and torque (3,) N m about its centre
+        on ball i, the same on ball j, or on the plate) in the plate frame: the normal force
+        of its law and, with friction, its friction force and rolling torque."""
+        m = self.model
+        n, i, j = len(m.mass), int(m.pi[p]), int(m.pj[p])
+        c = self.contacts
+        f, _, nx, ny, nz = pair_force(self.y, n, p, m.pi, m.pj, m.law, m.rsum, c.ramp, c.clamped,
+                                      m.phi, m.mass, m.g, m.omega, m.zeta, m.f_dead)  # fmt: skip
+        normal = f * np.array([nx, ny, nz])
+        force_i, torque_i, torque_j = normal.copy(), np.zeros(3), np.zeros(3)
+        if m.friction:
+            off = spin_offset(n, m.omega.shape[0])
+            r = pair_friction(self.y, n, off, i, j, p, nx, ny, nz, f, m.fric)
+            force_i += np.array(r[0:3])
+            torque_i, torque_j = np.array(r[3:6]), np.array(r[6:9])
+        return force_i, torque_i, -force_i, torque_j
+
     def contact_energies(self) -> np.ndarray:
         """Elastic energy (J, (P,)) of every pair now: ``contact_energy`` of each."""
         m = self.model
@@ -259,7 +280,7 @@ class ActiveSet:
     def remove_ball(self, b: int):
         """Stop integrating ball b (after a leave): its touching pairs end."""
         m = self.model
-        m.alive[b] = False
+        m.alive[b] = GONE
         self.contacts.touching[(m.pi == b) | (m.pj == b)] = False
         for p in np.flatnonzero((m.pi == b) | (m.pj == b)):
             self.io.forget_fresh(int(p))
