@@ -113,6 +113,22 @@ def test_rolling_resistance_holds_a_ball_exactly_where_tan_theta_is_below_mu_r()
     assert np.max(np.abs(w)) <= 1e-10
 
 
+def test_two_touching_balls_are_held_together_by_one_constraint_solve():
+    """Two coal balls touching side by side (1 nm overlap) on 10 deg, mu_r = 0.2 > tan
+    theta: both plate contacts stuck and held, the ball-ball contact too (its rolling,
+    under a ~1e-4 N normal force, breaks loose at once): the constraint forces of the three
+    contacts come from one (singular) system, and both balls stay at rest."""
+    a, _ell, _m, _i = resting(10.0, name="a")
+    b = Ball("b", COAL, R, (a.position[0] + 2 * R - 1e-9, 0.0, a.position[2]))
+    res = run([a, b], 10.0, coulomb(0.5, rolling=0.2), 0.02)
+    assert [(str(e.kind), e.partner) for e in res.events if e.kind != EventKind.CONTACT_START] == [
+        ("roll_free", "b")
+    ]  # fmt: skip
+    _n, x, v = res.states[-1]
+    assert np.max(np.abs(v)) <= 1e-12 and np.max(np.abs(res.spins[-1])) <= 1e-10
+    assert np.max(np.abs(x - np.array([a.position, b.position]))) <= 1e-13
+
+
 def test_rolling_resistance_lets_go_and_slows_the_roll_at_the_closed_form_rate():
     """20 deg, mu_r = 0.1 < tan theta: the held rolling breaks loose at once (ROLL_FREE at
     t = 0) and the ball rolls at a = g (sin theta - mu_r (r / l) cos theta) / (1 + I / (m l^2))
