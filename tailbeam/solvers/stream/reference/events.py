@@ -152,7 +152,7 @@ class EventSearch:
         plain = [r for r, row in enumerate(rows) if row.key.kind not in COULOMB]
         if plain:
             out[plain] = self.row_values([rows[r] for r in plain], x, v, modes)
-        coulomb = [r for r in range(len(rows)) if r not in set(plain)]
+        coulomb = [r for r, row in enumerate(rows) if row.key.kind in COULOMB]
         for k in range(x.shape[0]):
             pairs, f, fr, table = self.coulomb.at(x[k], v[k], w[k])
             index = {id(p): q for q, p in enumerate(pairs)}

@@ -69,20 +69,48 @@ def pair_friction(table, kin, normal_force, xi, vi, wi, xj, vj, wj) -> PairFrict
     (``PairKinematics``), their balls' centres, velocities and angular velocities (P', 3)
     (the plate: its foot point, zero velocities). ``table``: a ``FrictionTable`` whose
     arrays broadcast with the flattened pairs (tiled over the leading axes)."""
-    n = kin.normal
-    d = np.sqrt(np.einsum("pk,pk->p", xi - xj, xi - xj))
-    a_i = -(d * table.share)[:, None] * n
-    a_j = (d * (1.0 - table.share))[:, None] * n
-    u = vi + _cross(wi, a_i) - vj - _cross(wj, a_j)
-    slip = u - np.einsum("pk,pk->p", u, n)[:, None] * n
+    _d, a_i, a_j, _u, slip, roll = contact_motion(table, kin.normal, xi, vi, wi, xj, vj, wj)
     force = tangential_force(slip, normal_force, table.static, table.dynamic, table.v_s, table.v_d)
-    w = wi - wj
-    roll = w - np.einsum("pk,pk->p", w, n)[:, None] * n
     tau = rolling_torque(roll, normal_force, table.rolling, table.roll_radius, table.v_s)
     torque_i = _cross(a_i, force) + tau
     torque_j = -_cross(a_j, force) - tau
     power = -np.einsum("pk,pk->p", force, slip) - np.einsum("pk,pk->p", tau, roll)
     return PairFriction(force, torque_i, torque_j, slip, roll, power)
+
+
+def contact_motion(table, n, xi, vi, wi, xj, vj, wj) -> tuple:
+    """At the pairs' common contact points (module docstring), with unit normals n (P, 3):
+    the centres' distance d (P,) m, the lever arms a_i, a_j (P, 3) m, the relative velocity
+    u of the two material points, its tangential part (the slip) (P, 3) m/s, and the
+    rolling angular velocity (P, 3) rad/s."""
+    d = np.sqrt(np.einsum("pk,pk->p", xi - xj, xi - xj))
+    a_i = -(d * table.share)[:, None] * n
+    a_j = (d * (1.0 - table.share))[:, None] * n
+    u = vi + _cross(wi, a_i) - vj - _cross(wj, a_j)
+    slip = u - np.einsum("pk,pk->p", u, n)[:, None] * n
+    w = wi - wj
+    roll = w - np.einsum("pk,pk->p", w, n)[:, None] * n
+    return d, a_i, a_j, u, slip, roll
+
+
+def contact_bodies(ix, x, v, w, surface=None) -> tuple:
+    """The centres, velocities and angular velocities (K x P, 3 each) of the pairs ``ix``'s
+    balls i and j at K states x, v, w (K, n, 3), flattened state-major; the plate's side is
+    the foot point of ball i's centre, at rest, or moving at ``surface`` (K x P, 3; the
+    modal plate's top surface)."""
+    k, p = x.shape[0], len(ix.li)
+    if k == 1:
+        rows, li, lj, plate = 0, ix.li, ix.lj, ix.is_plate
+    else:
+        rows = np.repeat(np.arange(k), p)
+        li, lj, plate = np.tile(ix.li, k), np.tile(ix.lj, k), np.tile(ix.is_plate, k)
+    xi, vi, wi = x[rows, li], v[rows, li], w[rows, li]
+    xj, vj, wj = x[rows, lj], v[rows, lj], w[rows, lj]
+    xj[plate] = xi[plate] * np.array([1.0, 1.0, 0.0])
+    vj[plate], wj[plate] = 0.0, 0.0
+    if surface is not None:
+        vj[plate] = surface[plate]
+    return xi, vi, wi, xj, vj, wj
 
 
 def _cross(a, b) -> np.ndarray:
@@ -104,19 +132,9 @@ def friction_of(table, ix, kin, x, v, w, force, surface=None) -> PairFriction:
     ``PairIndex``) with kinematics ``kin`` at states x, v, w (K, n, 3) and normal forces
     ``force`` (K x P flattened, N); ``surface``: the plate surface's velocity under each
     pair (K x P, 3; m/s) on the modal plate, None on the rigid plate."""
-    k, p = x.shape[0], len(ix.li)
-    if k == 1:
-        rows, li, lj, plate = 0, ix.li, ix.lj, ix.is_plate
-    else:
-        rows = np.repeat(np.arange(k), p)
-        li, lj, plate = np.tile(ix.li, k), np.tile(ix.lj, k), np.tile(ix.is_plate, k)
-    xi, vi, wi = x[rows, li], v[rows, li], w[rows, li]
-    xj, vj, wj = x[rows, lj], v[rows, lj], w[rows, lj]
-    xj[plate] = xi[plate] * np.array([1.0, 1.0, 0.0])
-    vj[plate], wj[plate] = 0.0, 0.0
-    if surface is not None:
-        vj[plate] = surface[plate]
-    return pair_friction(tile(table, k) if k > 1 else table, kin, force, xi, vi, wi, xj, vj, wj)
+    k = x.shape[0]
+    bodies = contact_bodies(ix, x, v, w, surface)
+    return pair_friction(tile(table, k) if k > 1 else table, kin, force, *bodies)
 
 
 def slip_speed(pair, kinematics, radius, x, v, w, modes=None) -> float:

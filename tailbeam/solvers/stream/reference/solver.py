@@ -73,7 +73,6 @@ from tailbeam.solvers.stream.reference.changes import SceneChanges
 from tailbeam.solvers.stream.reference.contacts import ContactLog
 from tailbeam.solvers.stream.reference.dynamics import Dynamics
 from tailbeam.solvers.stream.reference.events import EventSearch
-from tailbeam.solvers.stream.reference.friction import FrictionTable
 from tailbeam.solvers.stream.reference.kinematics import Kinematics
 from tailbeam.solvers.stream.reference.loop import Integrator, StepLoop
 from tailbeam.solvers.stream.reference.pairs import PairSet
@@ -247,8 +246,7 @@ def _simulate(balls, incline, table, release, plate, duration, rtol, max_steps, 
     integrator = Integrator(dynamics, layout, plate, rtol, radius)
     loop = StepLoop(integrator, search, changes, series, max_steps, progress)
     if friction is not None and friction.coulomb:
-        coulomb = CoulombState(layout, kinematics, pairs, mass, radius, incline.gravity_vector,
-                               FrictionTable.of)  # fmt: skip
+        coulomb = CoulombState(layout, kinematics, pairs, mass, radius, incline.gravity_vector)
         changes.coulomb = series.coulomb = search.coulomb = coulomb
     y = _initial_state(balls, present, plate, layout.spin)
     changes.touch(list(pairs.values()), 0.0, y)

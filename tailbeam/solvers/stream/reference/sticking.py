@@ -24,7 +24,13 @@ import numpy as np
 
 from tailbeam.physics.contact_law import impact_force_in_region
 from tailbeam.physics.friction import rolling_torque, tangential_force
-from tailbeam.solvers.stream.reference.friction import PairFriction, _cross
+from tailbeam.solvers.stream.reference.friction import (
+    FrictionTable,
+    PairFriction,
+    _cross,
+    contact_bodies,
+    contact_motion,
+)
 from tailbeam.solvers.stream.reference.pairs import law_table
 
 SLIP_TINY = 1e-12  # m/s: a slip (or R x rolling rate) below it takes the stored direction
@@ -53,30 +59,22 @@ class Geometry:
     velocity."""
 
     def __init__(self, table, ix, kin, x, v, w):
-        li, lj, plate = ix.li, ix.lj, ix.is_plate
-        self.li, self.lj, self.plate = li, lj, plate
-        xi, vi, self.wi = x[li], v[li], w[li]
-        xj, vj, wj = x[lj].copy(), v[lj].copy(), w[lj].copy()
-        xj[plate] = xi[plate] * np.array([1.0, 1.0, 0.0])
-        vj[plate], wj[plate] = 0.0, 0.0
-        self.wj = wj
+        self.li, self.lj, self.plate = ix.li, ix.lj, ix.is_plate
+        xi, vi, self.wi, xj, vj, self.wj = contact_bodies(ix, x[None], v[None], w[None])
         n = self.n = kin.normal
+        d, self.a_i, self.a_j, u, self.slip, self.roll = contact_motion(
+            table, n, xi, vi, self.wi, xj, vj, self.wj
+        )
         rel = vi - vj
-        d = np.sqrt(np.einsum("pk,pk->p", xi - xj, xi - xj))
         d_rate = np.einsum("pk,pk->p", rel, n)
         n_rate = (rel - d_rate[:, None] * n) / d[:, None]
-        n_rate[plate] = 0.0  # (the foot point moves with the ball: the normal stays z)
+        n_rate[self.plate] = 0.0  # (the foot point moves with the ball: the normal stays z)
         self.n_rate = n_rate
         share = table.share
-        self.a_i, self.a_j = -(d * share)[:, None] * n, (d * (1.0 - share))[:, None] * n
         arm_rate = d_rate[:, None] * n + d[:, None] * n_rate
         self.a_i_rate, self.a_j_rate = -share[:, None] * arm_rate, (1 - share)[:, None] * arm_rate
-        u = vi + _cross(self.wi, self.a_i) - vj - _cross(wj, self.a_j)
         self.u_n = np.einsum("pk,pk->p", u, n)
-        self.slip = u - self.u_n[:, None] * n
-        wr = self.wi - wj
-        self.w_n = np.einsum("pk,pk->p", wr, n)
-        self.roll = wr - self.w_n[:, None] * n
+        self.w_n = np.einsum("pk,pk->p", self.wi - self.wj, n)
 
 
 def coulomb_friction(table, pairs, ix, kin, normal, x, v, w, mass, inertia, gravity):
@@ -180,14 +178,11 @@ class CoulombState:
         Every ball's mass (kg) and radius (m).
     gravity : ndarray
         Gravity in the plate frame (3,) m/s^2.
-    table_of : callable
-        ``FrictionTable.of``-like: the friction table of a list of pairs.
     """
 
-    def __init__(self, layout, kinematics, pairs, mass, radius, gravity, table_of):
+    def __init__(self, layout, kinematics, pairs, mass, radius, gravity):
         self.layout, self.kinematics, self.pairs = layout, kinematics, pairs
         self.mass, self.radius, self.gravity = mass, radius, gravity
-        self.table_of = table_of
 
     def any(self) -> bool:
         """Whether a pair in contact has Coulomb's law."""
@@ -204,6 +199,6 @@ class CoulombState:
         f = impact_force_in_region(kin.penetration, kin.rate, law_table(pairs), ramp, clamped)
         m = self.mass[self.layout.active]
         inertia = 0.4 * m * self.radius[self.layout.active] ** 2
-        table = self.table_of(pairs, self.radius)
+        table = FrictionTable.of(pairs, self.radius)
         fr = coulomb_friction(table, pairs, ix, kin, f, x, v, w, m, inertia, self.gravity)
         return pairs, f, fr, table
